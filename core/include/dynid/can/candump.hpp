@@ -1,0 +1,87 @@
+#pragma once
+// candump log files ("candump -l" format, replayed by canplayer).
+//
+// Line format: "(<seconds>.<fraction>) <interface> <frame>" where <frame> is
+//   123#0011223344556677   classic CAN, 3 hex digits = 11-bit id, 8 digits = 29-bit id
+//   123##<flags><data>     CAN FD: one hex nibble of flags (1 = BRS, 2 = ESI), up to 64 bytes
+//   123#R  or 123#R<dlc>   remote request (no data)
+//   123#                   empty payload
+// Data bytes may be separated by '.'. Blank lines are skipped.
+//
+// Contract: the reader never throws for a bad line. It records the line number and reason,
+// counts it, and by default continues with the next line; with OnError::Stop it stops at the
+// first bad line (next() returns false and stopped() is true). Only the first
+// kMaxKeptErrors errors are kept in errors(); error_count() counts all of them.
+#include <cstddef>
+#include <dynid/can/frame.hpp>
+#include <filesystem>
+#include <fstream>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace dynid::can {
+
+// Parses one log line into `frame`. Returns "" on success, else the reason the line is bad
+// (`frame` is then unspecified).
+std::string parse_candump_line(std::string_view line, Frame& frame);
+
+// One line in candump -l format, without the newline. Throws InputError for a frame that
+// cannot be written (negative or non-finite timestamp, empty interface name, id too large
+// for its kind, classic length > 8, FD length not a valid FD length).
+std::string format_candump_line(const Frame& frame);
+
+struct LogError {
+  std::size_t line = 0;
+  std::string reason;
+};
+
+enum class OnError { Continue, Stop };
+
+class CandumpReader {
+ public:
+  static constexpr std::size_t kMaxKeptErrors = 1000;
+
+  // Reads from `in`, which must outlive the reader; `source` names it in messages.
+  CandumpReader(std::istream& in, std::string source, OnError on_error = OnError::Continue);
+  // Opens a file; throws InputError if it cannot be opened.
+  explicit CandumpReader(const std::filesystem::path& path, OnError on_error = OnError::Continue);
+
+  // The next good frame; false at the end of the input or after stopping on an error.
+  bool next(Frame& frame);
+
+  const std::vector<LogError>& errors() const { return errors_; }
+  std::size_t error_count() const { return error_count_; }
+  std::size_t frame_count() const { return frame_count_; }
+  std::size_t line_number() const { return line_; }
+  bool stopped() const { return stopped_; }
+  const std::string& source() const { return source_; }
+  // "<source>:<line>: <reason>" for one recorded error.
+  std::string describe(const LogError& error) const;
+
+ private:
+  std::unique_ptr<std::ifstream> file_;
+  std::istream* in_;
+  std::string source_;
+  OnError on_error_;
+  std::string buffer_;
+  std::vector<LogError> errors_;
+  std::size_t error_count_ = 0;
+  std::size_t frame_count_ = 0;
+  std::size_t line_ = 0;
+  bool stopped_ = false;
+};
+
+class CandumpWriter {
+ public:
+  explicit CandumpWriter(std::ostream& out) : out_(out) {}
+  // Throws InputError (see format_candump_line); nothing is written then.
+  void write(const Frame& frame);
+
+ private:
+  std::ostream& out_;
+};
+
+}  // namespace dynid::can

@@ -1,0 +1,178 @@
+#pragma once
+// A CAN database (Vector DBC) held in memory, and its parser.
+//
+// Contract:
+// - parse_dbc_file / parse_dbc_string read the sections real files use: VERSION, NS_, BS_,
+//   BU_, BO_ (bit 31 of the id = 29-bit extended id), SG_ (Intel "@1" and Motorola "@0",
+//   signed/unsigned, multiplexers "M", "m3", "m3M"), SIG_VALTYPE_ (IEEE float/double),
+//   SG_MUL_VAL_ (extended multiplexing ranges), VAL_TABLE_, VAL_, CM_ (multi-line, escaped
+//   quotes), BA_DEF_, BA_DEF_DEF_, BA_, BO_TX_BU_, EV_, SIG_GROUP_; CRLF and UTF-8 are fine.
+//   Other sections (BA_DEF_REL_, SGTYPE_, CAT_, FILTER, ...) are skipped.
+// - Syntax errors and inconsistent layouts (signal beyond 64 bytes, float signal not 32/64
+//   bits, multiplexer cycle, duplicate id) throw dynid::InputError "<name>:<line>: <what>:
+//   <reason>". References to objects the file does not define (CM_/BA_/VAL_ for an unknown
+//   message or signal) are not fatal: they are listed in Database::warnings with file:line.
+// - The returned Database is immutable in use: decoders keep pointers into it.
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <variant>
+#include <vector>
+
+namespace dynid::can {
+
+enum class ByteOrder { Intel, Motorola };     // "@1" little endian, "@0" big endian
+enum class ValueType { Integer, Float32, Float64 };  // SIG_VALTYPE_ 0, 1, 2
+
+// An attribute value keeps the type the file gave it: integers (INT, HEX, ENUM index),
+// reals (FLOAT) and strings (STRING, or ENUM written by name).
+using AttributeValue = std::variant<std::int64_t, double, std::string>;
+using Attributes = std::map<std::string, AttributeValue, std::less<>>;
+
+enum class AttributeScope { Network, Node, Message, Signal, EnvVar };
+enum class AttributeType { Int, Hex, Float, String, Enum };
+
+struct AttributeDefinition {
+  std::string name;
+  AttributeScope scope = AttributeScope::Network;
+  AttributeType type = AttributeType::String;
+  double minimum = 0.0;  // INT/HEX/FLOAT only
+  double maximum = 0.0;
+  std::vector<std::string> enum_values;        // ENUM only
+  std::optional<AttributeValue> default_value;  // BA_DEF_DEF_
+};
+
+// Raw values of a multiplexer switch for which a multiplexed signal is present (inclusive).
+struct MuxRange {
+  std::uint64_t low = 0;
+  std::uint64_t high = 0;
+};
+
+struct Signal {
+  std::string name;
+  std::uint32_t start_bit = 0;  // Intel: LSB; Motorola: MSB, in DBC "sawtooth" numbering
+  std::uint32_t length = 0;     // bits, 1..64
+  ByteOrder byte_order = ByteOrder::Intel;
+  bool is_signed = false;
+  ValueType value_type = ValueType::Integer;
+  double factor = 1.0;
+  double offset = 0.0;
+  double minimum = 0.0;
+  double maximum = 0.0;
+  std::string unit;
+  std::vector<std::string> receivers;
+  std::string comment;
+  Attributes attributes;
+  std::map<std::int64_t, std::string> value_descriptions;  // VAL_
+
+  // Multiplexing. `is_multiplexer` marks a switch ("M" or "m3M"). A multiplexed signal
+  // ("m3", "m3M") is present when its switch (`multiplexer`, the message's only "M" unless
+  // SG_MUL_VAL_ names another) holds a raw value in one of `mux_ranges`.
+  bool is_multiplexer = false;
+  std::optional<std::uint64_t> mux_value;  // the value written in "m<value>"
+  std::string multiplexer;                 // name of the switch, empty if not multiplexed
+  std::vector<MuxRange> mux_ranges;
+
+  // Filled by the parser: index of the switch signal in the message, or -1.
+  int multiplexer_index = -1;
+
+  bool is_multiplexed() const { return mux_value.has_value(); }
+  bool mux_accepts(std::uint64_t switch_raw) const;
+};
+
+struct SignalGroup {
+  std::string name;
+  std::uint32_t repetitions = 1;
+  std::vector<std::string> signals;
+};
+
+struct Message {
+  std::uint32_t id = 0;  // 11 or 29 bits, without the DBC's bit 31
+  bool extended = false;
+  std::string name;
+  std::uint32_t size = 0;  // bytes, 0..64 (CAN FD above 8)
+  std::string transmitter;
+  std::vector<std::string> extra_transmitters;  // BO_TX_BU_
+  std::vector<Signal> signals;
+  std::vector<SignalGroup> signal_groups;
+  std::string comment;
+  Attributes attributes;
+
+  // Filled by the parser.
+  std::uint32_t required_bytes = 0;       // smallest payload that holds every signal
+  std::vector<std::size_t> decode_order;  // switches before the signals they select
+  bool fd = false;                        // VFrameFormat says CAN FD (or size > 8)
+  // Vector's VECTOR__INDEPENDENT_SIG_MSG (DBC id 0xC0000000) parks unused signals; it is never
+  // on the bus, so id lookups do not find it.
+  bool is_pseudo = false;
+
+  // Index of the signal called `name`, or nullopt. O(1).
+  std::optional<std::size_t> signal_index(std::string_view signal_name) const;
+  const Signal* find_signal(std::string_view signal_name) const;
+
+  std::unordered_map<std::string, std::size_t> signal_by_name;  // filled by the parser
+};
+
+struct Node {
+  std::string name;
+  std::string comment;
+  Attributes attributes;
+};
+
+struct EnvironmentVariable {
+  std::string name;
+  int type = 0;  // 0 integer, 1 float, 2 string
+  double minimum = 0.0;
+  double maximum = 0.0;
+  std::string unit;
+  double initial_value = 0.0;
+  std::int64_t ev_id = 0;
+  std::string access_type;
+  std::vector<std::string> access_nodes;
+  std::string comment;
+  Attributes attributes;
+  std::map<std::int64_t, std::string> value_descriptions;
+};
+
+// The DBC's own id: 11-bit ids as they are, 29-bit ids with bit 31 set.
+constexpr std::uint32_t kDbcExtendedFlag = 0x80000000U;
+constexpr std::uint32_t dbc_key(std::uint32_t id, bool extended) {
+  return extended ? (id | kDbcExtendedFlag) : id;
+}
+
+struct Database {
+  std::string source;  // file name or the name given to parse_dbc_string
+  std::string version;
+  std::vector<std::string> new_symbols;  // NS_
+  std::vector<Node> nodes;
+  std::map<std::string, std::map<std::int64_t, std::string>, std::less<>> value_tables;
+  std::vector<Message> messages;
+  std::vector<EnvironmentVariable> environment_variables;
+  std::map<std::string, AttributeDefinition, std::less<>> attribute_definitions;
+  Attributes network_attributes;
+  std::string comment;
+  std::vector<std::string> warnings;  // "<name>:<line>: ..." for dangling references
+
+  // Lookup by CAN id, O(1). Returns nullptr for an id the database does not describe.
+  const Message* find_message(std::uint32_t id, bool extended) const;
+  const Message* find_message(std::string_view name) const;
+
+  // The DBC id as written (dbc_key, or 0xC0000000 for the pseudo message) -> index.
+  std::unordered_map<std::uint32_t, std::size_t> message_by_key;
+  std::size_t signal_count() const;
+};
+
+// The attribute value of an object, or the definition's default when the object has none.
+// ENUM values are returned as their name. nullopt when neither exists.
+std::optional<AttributeValue> attribute_value(const Database& db, const Attributes& own,
+                                              std::string_view name);
+
+Database parse_dbc_string(std::string_view text, std::string_view name);
+Database parse_dbc_file(const std::filesystem::path& path);
+
+}  // namespace dynid::can

@@ -1,0 +1,199 @@
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <dynid/can/candump.hpp>
+#include <dynid/error.hpp>
+#include <istream>
+#include <ostream>
+
+namespace dynid::can {
+namespace {
+
+constexpr std::uint32_t kCanErrFlag = 0x20000000U;  // Linux CAN_ERR_FLAG in an 8-digit id
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+int hex_value(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  return -1;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+// Cuts the next blank-separated word off `s`.
+std::string_view next_word(std::string_view& s) {
+  s = trim(s);
+  std::size_t n = 0;
+  while (n < s.size() && !is_space(s[n])) ++n;
+  const std::string_view w = s.substr(0, n);
+  s.remove_prefix(n);
+  return w;
+}
+
+std::string quoted(std::string_view s) { return "'" + std::string(s.substr(0, 40)) + "'"; }
+
+std::string parse_timestamp(std::string_view word, Frame& f) {
+  if (word.size() < 3 || word.front() != '(' || word.back() != ')')
+    return "expected a timestamp in parentheses, found " + quoted(word);
+  const std::string_view digits = word.substr(1, word.size() - 2);
+  for (const char c : digits)
+    if ((c < '0' || c > '9') && c != '.') return "bad timestamp " + quoted(word);
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), f.timestamp);
+  if (ec != std::errc() || end != digits.data() + digits.size() || !std::isfinite(f.timestamp))
+    return "bad timestamp " + quoted(word);
+  return {};
+}
+
+std::string parse_id(std::string_view hex, Frame& f) {
+  if (hex.size() != 3 && hex.size() != 8)
+    return "the id must have 3 (standard) or 8 (extended) hex digits, found " + quoted(hex);
+  std::uint32_t id = 0;
+  for (const char c : hex) {
+    if (hex_value(c) < 0) return "bad hex digit in the id " + quoted(hex);
+    id = id * 16 + static_cast<std::uint32_t>(hex_value(c));
+  }
+  f.extended = hex.size() == 8;
+  if (f.extended && (id & kCanErrFlag) != 0) return "error frame (CAN_ERR_FLAG) " + quoted(hex);
+  if (id > (f.extended ? Frame::kMaxExtendedId : Frame::kMaxStandardId))
+    return "id " + quoted(hex) + " is out of range";
+  f.id = id;
+  return {};
+}
+
+// Hex byte pairs, optionally separated by '.', into f.data.
+std::string parse_data(std::string_view hex, std::size_t max_bytes, Frame& f) {
+  std::size_t n = 0;
+  std::size_t i = 0;
+  while (i < hex.size()) {
+    if (hex[i] == '.') {
+      ++i;
+      continue;
+    }
+    if (hex[i] == '_' && !f.fd && n == Frame::kMaxClassicData && i + 2 == hex.size() &&
+        hex_value(hex[i + 1]) > 8)
+      break;  // "_<dlc>": classic frame with a raw DLC 9..15 carries 8 bytes
+    if (i + 1 >= hex.size() || hex_value(hex[i]) < 0 || hex_value(hex[i + 1]) < 0)
+      return "bad hex data at " + quoted(hex.substr(i)) + " (bytes are two hex digits)";
+    if (n == max_bytes)
+      return "payload longer than " + std::to_string(max_bytes) + " bytes" +
+             (f.fd ? "" : " (classic CAN; CAN FD uses '##')");
+    f.data[n++] = static_cast<std::uint8_t>(hex_value(hex[i]) * 16 + hex_value(hex[i + 1]));
+    i += 2;
+  }
+  f.length = static_cast<std::uint8_t>(n);
+  if (f.fd && !is_valid_fd_length(n))
+    return "CAN FD payload of " + std::to_string(n) + " bytes is not a valid FD length";
+  return {};
+}
+
+std::string parse_frame(std::string_view word, Frame& f) {
+  const std::size_t hash = word.find('#');
+  if (hash == std::string_view::npos) return "expected <id>#<data>, found " + quoted(word);
+  if (std::string err = parse_id(word.substr(0, hash), f); !err.empty()) return err;
+  std::string_view rest = word.substr(hash + 1);
+  f.fd = !rest.empty() && rest.front() == '#';
+  if (f.fd) {
+    if (rest.size() < 2 || hex_value(rest[1]) < 0) return "CAN FD frame without its flags nibble";
+    f.fd_flags = static_cast<std::uint8_t>(hex_value(rest[1]));
+    return parse_data(rest.substr(2), Frame::kMaxFdData, f);
+  }
+  if (!rest.empty() && (rest.front() == 'R' || rest.front() == 'r')) {
+    f.rtr = true;
+    const bool has_dlc = rest.size() == 2 && hex_value(rest[1]) >= 0 && hex_value(rest[1]) <= 8;
+    if (rest.size() > 2 || (rest.size() == 2 && !has_dlc))
+      return "bad remote frame " + quoted(word) + " (expected R or R<dlc 0..8>)";
+    f.length = has_dlc ? static_cast<std::uint8_t>(hex_value(rest[1])) : 0;
+    return {};
+  }
+  return parse_data(rest, Frame::kMaxClassicData, f);
+}
+
+void check_writable(const Frame& f) {
+  if (!std::isfinite(f.timestamp) || f.timestamp < 0.0)
+    throw InputError("candump writer: timestamp " + std::to_string(f.timestamp) +
+                     " is not a finite non-negative number");
+  if (f.interface_name().empty()) throw InputError("candump writer: frame has no interface name");
+  if (f.id > (f.extended ? Frame::kMaxExtendedId : Frame::kMaxStandardId))
+    throw InputError("candump writer: id " + std::to_string(f.id) + " too large for " +
+                     (f.extended ? "a 29-bit id" : "an 11-bit id"));
+  if (f.fd ? !is_valid_fd_length(f.length) : f.length > Frame::kMaxClassicData)
+    throw InputError("candump writer: payload length " + std::to_string(f.length) +
+                     " invalid for " + (f.fd ? "CAN FD" : "classic CAN"));
+  if (f.fd && f.rtr) throw InputError("candump writer: CAN FD has no remote frames");
+}
+
+}  // namespace
+
+std::string parse_candump_line(std::string_view line, Frame& frame) {
+  frame = Frame{};
+  std::string_view rest = line;
+  if (std::string err = parse_timestamp(next_word(rest), frame); !err.empty()) return err;
+  const std::string_view iface = next_word(rest);
+  if (iface.empty()) return "missing interface name after the timestamp";
+  if (!frame.set_interface_name(iface))
+    return "interface name " + quoted(iface) + " is longer than 15 characters";
+  const std::string_view word = next_word(rest);
+  if (word.empty()) return "missing frame after the interface name";
+  if (std::string err = parse_frame(word, frame); !err.empty()) return err;
+  if (!trim(rest).empty()) return "unexpected text after the frame: " + quoted(trim(rest));
+  return {};
+}
+
+std::string format_candump_line(const Frame& f) {
+  check_writable(f);
+  const long long micros = std::llround(f.timestamp * 1e6);
+  char head[48];
+  std::snprintf(head, sizeof head, "(%010lld.%06lld) ", micros / 1000000, micros % 1000000);
+  char id[16];
+  std::snprintf(id, sizeof id, f.extended ? "%08X" : "%03X", static_cast<unsigned>(f.id));
+  std::string out = std::string(head) + std::string(f.interface_name()) + " " + id + "#";
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  if (f.rtr) return out + "R" + (f.length > 0 ? std::string(1, kHex[f.length]) : "");
+  if (f.fd) out += std::string("#") + kHex[f.fd_flags & 0xF];
+  for (const std::uint8_t b : f.payload()) {
+    out.push_back(kHex[b >> 4]);
+    out.push_back(kHex[b & 0xF]);
+  }
+  return out;
+}
+
+CandumpReader::CandumpReader(std::istream& in, std::string source, OnError on_error)
+    : in_(&in), source_(std::move(source)), on_error_(on_error) {}
+
+CandumpReader::CandumpReader(const std::filesystem::path& path, OnError on_error)
+    : file_(std::make_unique<std::ifstream>(path, std::ios::binary)),
+      in_(file_.get()),
+      source_(path.filename().string()),
+      on_error_(on_error) {
+  if (!*file_) throw InputError(path.string() + ": cannot open the candump log");
+}
+
+bool CandumpReader::next(Frame& frame) {
+  while (!stopped_ && std::getline(*in_, buffer_)) {
+    ++line_;
+    if (trim(buffer_).empty()) continue;
+    std::string reason = parse_candump_line(buffer_, frame);
+    if (reason.empty()) {
+      ++frame_count_;
+      return true;
+    }
+    ++error_count_;
+    if (errors_.size() < kMaxKeptErrors) errors_.push_back(LogError{line_, std::move(reason)});
+    stopped_ = on_error_ == OnError::Stop;
+  }
+  return false;
+}
+
+std::string CandumpReader::describe(const LogError& error) const {
+  return source_ + ":" + std::to_string(error.line) + ": " + error.reason;
+}
+
+void CandumpWriter::write(const Frame& frame) { out_ << format_candump_line(frame) << '\n'; }
+
+}  // namespace dynid::can

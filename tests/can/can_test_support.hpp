@@ -1,0 +1,27 @@
+#pragma once
+// Shared helpers of the CAN tests: where the reference data is, and skipping without it.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace dynid::can::test {
+
+std::filesystem::path shared_data();
+std::filesystem::path opendbc_dir();
+std::filesystem::path rav4_dir();
+
+// Every *.dbc in opendbc/, sorted.
+std::vector<std::filesystem::path> opendbc_files();
+
+// Runs a shell command and returns its standard output; sets `status` to the exit code.
+std::string run_command(const std::string& command, int& status);
+
+}  // namespace dynid::can::test
+
+// Skips the test with a clear message when a reference folder is absent.
+#define DYNID_REQUIRE_DIR(dir)                                                            \
+  do {                                                                                    \
+    if (!std::filesystem::is_directory(dir))                                              \
+      GTEST_SKIP() << "reference data folder " << (dir)                                   \
+                   << " is absent (set -DDYNID_SHARED_DATA to the shared data folder)";   \
+  } while (0)
