@@ -1,0 +1,50 @@
+#pragma once
+// ChannelSet: preprocessed measurement channels of one run on a uniform time grid, the input of
+// every model (DYCARO's script_obs reads the output of script_filtre).
+//
+// Contract: every channel has the same number of samples; values are SI (conversions happen
+// where signals enter: the car-side profile); `valid(k)` is false for samples inside a detected
+// gap or bad stretch, and models leave such rows out. Channel names follow the catalogue in
+// docs/CHANNELS.md. Adding a channel of the wrong length, a duplicate name, or a NaN/Inf at a
+// sample marked valid throws InputError naming the channel and sample.
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace dynid::model {
+
+class ChannelSet {
+ public:
+  /// An empty set of `samples` samples every `sample_period` seconds (> 0), all valid.
+  ChannelSet(double sample_period, Eigen::Index samples);
+
+  double sample_period() const { return sample_period_; }
+  Eigen::Index samples() const { return samples_; }
+
+  /// Adds a channel (SI unit given for documentation and checks).
+  void add(const std::string& name, const std::string& unit, Eigen::VectorXd values);
+  bool has(const std::string& name) const { return channels_.count(name) > 0; }
+  /// The values of a channel; throws InputError naming the missing channel.
+  const Eigen::VectorXd& operator[](const std::string& name) const;
+  const std::string& unit(const std::string& name) const;
+  std::vector<std::string> names() const;
+
+  /// Marks samples [first, first + count) invalid (a gap, a NaN run, a saturated sensor...).
+  void invalidate(Eigen::Index first, Eigen::Index count);
+  bool valid(Eigen::Index k) const { return valid_[static_cast<std::size_t>(k)]; }
+  Eigen::Index valid_count() const;
+
+ private:
+  struct Channel {
+    std::string unit;
+    Eigen::VectorXd values;
+  };
+  double sample_period_;
+  Eigen::Index samples_;
+  std::map<std::string, Channel> channels_;
+  std::vector<bool> valid_;
+};
+
+}  // namespace dynid::model

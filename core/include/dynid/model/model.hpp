@@ -1,0 +1,75 @@
+#pragma once
+// Model: one identification model, linear in its parameters (Venture 2003 §2.B: Y = W X + rho).
+//
+// A model declares its parameters (name, SI unit, a-priori value), the channels it needs, its
+// equation groups (one accumulator each, weighted by DYCARO's 1/sigma_j) and its candidate
+// effects: named extra columns that the residual loop may add. Given preprocessed channels it
+// builds the regressor rows of every group. Models hold only constants (from the vehicle
+// profile): they are immutable and may be shared by threads.
+//
+// Column order of the rows: parameters() first, then, for each enabled effect in the order
+// given, that effect's parameters. Rows at invalid samples (ChannelSet::valid) and samples the
+// model must mask (e.g. a clutch model where the slip speed is ~0, a longitudinal model while
+// braking when brake force is not modelled) are left out.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "dynid/model/channel_set.hpp"
+
+namespace dynid::model {
+
+struct ParameterInfo {
+  std::string name;         ///< e.g. "mass", unique within the model and its effects
+  std::string unit;         ///< SI, e.g. "kg", "N/rad", "kg m^2"
+  std::string description;
+  std::optional<double> a_priori;  ///< a known or nominal value, if any
+};
+
+struct ChannelNeed {
+  std::string name;  ///< from docs/CHANNELS.md
+  std::string unit;
+  bool optional = false;  ///< used when present (e.g. by an effect), not required
+};
+
+struct Effect {
+  std::string name;         ///< e.g. "road_grade", "anti_roll_bar", "dict:sq:vx"
+  std::string description;  ///< the physics, one line
+  std::vector<ParameterInfo> parameters;  ///< the extra columns it adds
+  std::vector<std::string> channels;      ///< channels it needs beyond the model's own
+};
+
+struct GroupRows {
+  std::string group;
+  Eigen::MatrixXd W;  ///< rows x (parameters + enabled effects' parameters)
+  Eigen::VectorXd y;
+  std::vector<Eigen::Index> samples;  ///< the sample index of each row (for residual plots)
+};
+
+class Model {
+ public:
+  virtual ~Model() = default;
+
+  virtual std::string name() const = 0;
+  virtual std::vector<ParameterInfo> parameters() const = 0;
+  virtual std::vector<ChannelNeed> channels() const = 0;
+  virtual std::vector<std::string> groups() const = 0;
+  /// The model's physical candidate effects (the generic dictionary is added by
+  /// dictionary_effects(), see effects.hpp).
+  virtual std::vector<Effect> candidate_effects() const = 0;
+
+  /// Rows of every group. Throws InputError naming a missing channel or an unknown effect, and
+  /// for channels that cannot give a sound estimate (constant where excitation is needed, ...).
+  virtual std::vector<GroupRows> rows(const ChannelSet& channels,
+                                      const std::vector<std::string>& effects = {}) const = 0;
+
+  /// All parameters with the enabled effects' parameters appended, in column order.
+  std::vector<ParameterInfo> parameters_with(const std::vector<std::string>& effects) const;
+  /// True when every non-optional channel is present.
+  bool can_run_on(const ChannelSet& channels) const;
+};
+
+}  // namespace dynid::model
