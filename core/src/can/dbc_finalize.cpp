@@ -131,6 +131,7 @@ std::uint32_t message_key(std::uint32_t raw_id) {
 
 std::string set_message_id(Message& m, std::uint32_t raw_id) {
   const std::uint32_t key = message_key(raw_id);
+  m.dbc_id = raw_id;
   m.extended = (key & kDbcExtendedFlag) != 0;
   m.id = key & ~kDbcExtendedFlag;
   if (m.id > Frame::kMaxExtendedId) {

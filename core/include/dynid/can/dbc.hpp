@@ -94,6 +94,7 @@ struct SignalGroup {
 struct Message {
   std::uint32_t id = 0;  // 11 or 29 bits, without the DBC's bit 31
   bool extended = false;
+  std::uint32_t dbc_id = 0;  // as written in the file (bit 31 = extended)
   std::string name;
   std::uint32_t size = 0;  // bytes, 0..64 (CAN FD above 8)
   std::string transmitter;
