@@ -478,9 +478,10 @@ class Parser {
       if (EnvironmentVariable* e = env_ref(at, env)) e->value_descriptions = std::move(pairs);
       return;
     }
-    Message* m = message_ref(at, expect_u32("a message id"));
+    const std::uint32_t id = expect_u32("a message id");
     const std::string sig = expect_ident("a signal name");
     context_ = "VAL_ '" + sig + "'";
+    Message* m = message_ref(at, id);
     auto pairs = value_pairs();
     if (Signal* s = signal_ref(at, m, sig)) s->value_descriptions = std::move(pairs);
   }
@@ -488,9 +489,10 @@ class Parser {
   // ---- signal extras --------------------------------------------------------------------
   void signal_value_type() {
     const Token& at = take();
-    Message* m = message_ref(at, expect_u32("a message id"));
+    const std::uint32_t id = expect_u32("a message id");
     const std::string sig = expect_ident("a signal name");
     context_ = "SIG_VALTYPE_ '" + sig + "'";
+    Message* m = message_ref(at, id);
     if (at_punct(':')) take();
     const Token& vt = peek();
     const std::uint64_t code = expect_uint("the value type (0, 1 or 2)");
@@ -502,9 +504,10 @@ class Parser {
   // "SG_MUL_VAL_ <id> <signal> <switch> 3-3, 5-10 ;". The lexer reads "3-3" as 3 and -3.
   void multiplex_ranges() {
     const Token& at = take();
-    Message* m = message_ref(at, expect_u32("a message id"));
+    const std::uint32_t id = expect_u32("a message id");
     const std::string sig = expect_ident("a signal name");
     context_ = "SG_MUL_VAL_ '" + sig + "'";
+    Message* m = message_ref(at, id);
     const std::string sw = expect_ident("the multiplexer switch name");
     std::vector<MuxRange> ranges;
     while (peek().kind == TokenKind::Number) {
