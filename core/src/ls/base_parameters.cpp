@@ -104,7 +104,8 @@ std::string BaseParameterAnalysis::relation(Eigen::Index k,
     const double c = regrouping(k, static_cast<Eigen::Index>(j));
     if (c == 0.0) continue;
     text += (c < 0 ? " - " : " + ");
-    if (std::abs(c) != 1.0) text += format_coefficient(c) + "*";
+    const std::string magnitude = format_coefficient(c);  // 6 digits: 1.0000000000000002 is 1
+    if (magnitude != "1") text += magnitude + "*";
     text += name_of(dependent[j]);
   }
   return text;
