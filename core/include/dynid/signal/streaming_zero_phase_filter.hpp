@@ -1,0 +1,84 @@
+#pragma once
+// Zero-phase (forward-backward) filtering of a signal that arrives in chunks, with a bounded
+// delay and bounded memory: what the server runs for each run's channel set.
+//
+// How: the forward pass is causal, so it runs exactly as the offline filter runs it, once the
+// first padlen + 1 samples (needed for the odd extension at the start) are in. The backward pass
+// would need the whole future; instead, a sample k is released once `overlap` forward outputs
+// beyond it are known: the backward pass is started at the newest forward output j >= k +
+// overlap, from the steady state for that value. The error this makes at k is the filter's
+// impulse response beyond `overlap` samples applied to the (bounded) signal variation, so the
+// overlap is chosen from the filter's own decay (its impulse response tail) to keep
+//     |streamed - zero_phase_filter(whole signal)| <= tolerance * max|x|   (per channel).
+// finish() handles the end exactly as the offline filter does (odd extension, steady state), so
+// the last samples, and the first ones, match the offline filter to rounding error.
+//
+// Delay rule: output sample k is returned by the push() that brings the number of input samples
+// to at least k + delay() + 1, with delay() = overlap() + block() - 1 and block() =
+// max(1, overlap() / 4) (the backward pass is run once per block of released samples; a smaller
+// block would cut the delay but cost a backward sweep of length overlap + block per block).
+// Memory between calls: O((overlap + block) x channels), whatever the length of the signal.
+#include <Eigen/Core>
+
+#include "dynid/signal/sos.hpp"
+
+namespace dynid::signal {
+
+class StreamingZeroPhaseFilter {
+ public:
+  // tolerance: bound on the error relative to max|x|, in [1e-13, 1e-3]; channels >= 1.
+  // Throws InputError otherwise.
+  StreamingZeroPhaseFilter(Sos sos, Eigen::Index channels, double tolerance = 1e-10);
+
+  // chunk: rows = samples, one column per channel (any number of rows, including 0). Returns the
+  // output samples that became final, in order, continuing the previous returns.
+  // Throws InputError, leaving the filter unchanged, when the column count is wrong, a sample is
+  // NaN or infinite (naming channel and sample index in the whole stream), or after finish().
+  Eigen::MatrixXd push(const Eigen::MatrixXd& chunk);
+
+  // Ends the signal and returns the remaining output samples. Throws InputError, leaving the
+  // filter unchanged, when fewer than padlen + 1 samples were pushed (as the offline filter) or
+  // when already finished.
+  Eigen::MatrixXd finish();
+
+  // Forgets the signal, keeps the filter: ready for a new one.
+  void reset();
+
+  Eigen::Index channels() const { return channels_; }
+  Eigen::Index padlen() const { return padlen_; }
+  Eigen::Index overlap() const { return overlap_; }
+  Eigen::Index block() const { return block_; }
+  Eigen::Index delay() const { return overlap_ + block_ - 1; }
+  Eigen::Index samples_in() const { return n_in_; }
+  Eigen::Index samples_out() const { return n_out_; }
+  bool finished() const { return finished_; }
+
+ private:
+  void start_forward();
+  void forward_into_pending(const Eigen::MatrixXd& x);
+  Eigen::MatrixXd release(Eigen::Index count);
+  void keep_raw_tail(const Eigen::MatrixXd& chunk);
+
+  Sos sos_;
+  Eigen::VectorXd unit_state_;  // steady state of the cascade for a unit constant input
+  Eigen::Index channels_;
+  Eigen::Index padlen_;
+  Eigen::Index overlap_;
+  Eigen::Index block_;
+
+  Eigen::Index n_in_ = 0;
+  Eigen::Index n_out_ = 0;
+  bool finished_ = false;
+  Eigen::MatrixXd head_;     // raw samples until padlen + 1 are in (the forward pass waits)
+  Eigen::MatrixXd raw_tail_; // last padlen + 1 raw samples, for the odd extension at the end
+  Eigen::MatrixXd forward_state_;  // 2 per section x channels
+  Eigen::MatrixXd pending_;  // forward outputs of samples n_out_.. (first pending_rows_ rows)
+  Eigen::Index pending_rows_ = 0;
+};
+
+// The number of samples after which the tail of the impulse response of `sos` is small enough
+// for StreamingZeroPhaseFilter: the smallest L with 6 ||h||_1 sum_{m > L} |h[m]| <= tolerance.
+// (6 ||h||_1 bounds the variation of a forward-filtered, odd-extended signal relative to max|x|.)
+Eigen::Index zero_phase_overlap(const Sos& sos, double tolerance);
+
+}  // namespace dynid::signal

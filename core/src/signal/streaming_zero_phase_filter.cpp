@@ -1,0 +1,200 @@
+#include "dynid/signal/streaming_zero_phase_filter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "cascade.hpp"
+#include "checks.hpp"
+#include "dynid/error.hpp"
+#include "dynid/signal/zero_phase_filter.hpp"
+
+namespace dynid::signal {
+namespace {
+
+void check_tolerance(double tolerance) {
+  // Below 1e-13 the tail sum is lost in the rounding of the total it is taken from.
+  if (!(tolerance >= 1e-13 && tolerance <= 1e-3))
+    throw InputError("zero-phase streaming: tolerance " + std::to_string(tolerance) +
+                     " must be within [1e-13, 1e-3]");
+}
+
+// Largest pole modulus of the cascade (< 1: Sos only holds stable sections).
+double pole_radius(const Sos& sos) {
+  double radius = 0.0;
+  for (const Biquad& s : sos.sections()) {
+    const double disc = s.a1 * s.a1 - 4.0 * s.a2;
+    const double r = disc < 0.0 ? std::sqrt(s.a2)
+                                : 0.5 * (std::abs(s.a1) + std::sqrt(disc));  // the larger root
+    radius = std::max(radius, r);
+  }
+  return radius;
+}
+
+// Calls visit(|h[m]|) for the impulse response h of the cascade until what is left in its
+// delays is negligible (1e-30 of their peak): the rest of h is then below any tolerance here.
+template <class Visit>
+void impulse_magnitudes(const Sos& sos, Visit visit) {
+  const double radius = pole_radius(sos);
+  const double horizon = std::log(1e-30) / std::log(std::max(radius, 1e-300));
+  if (horizon > 1e8)
+    throw InputError("zero-phase streaming: the filter decays too slowly (pole radius " +
+                     std::to_string(radius) + "); lower the sample rate or raise the cut-off");
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * sos.size());
+  double input = 1.0;
+  double peak = 0.0;
+  for (;;) {
+    const double h = detail::step(sos.sections(), z.data(), input);
+    input = 0.0;
+    if (!visit(std::abs(h))) return;
+    const double level = z.cwiseAbs().maxCoeff();
+    peak = std::max(peak, level);
+    if (level <= 1e-30 * peak) return;
+  }
+}
+
+}  // namespace
+
+Eigen::Index zero_phase_overlap(const Sos& sos, double tolerance) {
+  check_tolerance(tolerance);
+  double norm1 = 0.0;
+  impulse_magnitudes(sos, [&](double a) { norm1 += a; return true; });
+  // Error at a released sample <= sum_{m > L} |h[m]| * max|u - u_j| with u the forward output,
+  // |u| <= ||h||_1 * 3 max|x| (odd extension values reach 3 max|x|), so the variation <= 6 ...
+  const double allowed_tail = tolerance / (6.0 * norm1);
+  double prefix = 0.0;
+  Eigen::Index count = 0;
+  impulse_magnitudes(sos, [&](double a) {
+    prefix += a;
+    ++count;
+    return norm1 - prefix > allowed_tail;
+  });
+  return count;  // h[0..count) summed: the tail beyond L = count - 1 is small enough
+}
+
+StreamingZeroPhaseFilter::StreamingZeroPhaseFilter(Sos sos, Eigen::Index channels,
+                                                   double tolerance)
+    : sos_(std::move(sos)),
+      unit_state_(detail::unit_steady_state(sos_)),
+      channels_(channels),
+      padlen_(zero_phase_padlen(sos_)),
+      overlap_(std::max(zero_phase_overlap(sos_, tolerance), padlen_ + 1)),
+      block_(std::max<Eigen::Index>(1, overlap_ / 4)) {
+  detail::require_channel_count(channels, "StreamingZeroPhaseFilter");
+  reset();
+}
+
+void StreamingZeroPhaseFilter::reset() {
+  n_in_ = 0;
+  n_out_ = 0;
+  finished_ = false;
+  head_.resize(0, channels_);
+  raw_tail_.resize(0, channels_);
+  forward_state_.resize(unit_state_.size(), channels_);
+  pending_.resize(0, channels_);
+  pending_rows_ = 0;
+}
+
+Eigen::MatrixXd StreamingZeroPhaseFilter::push(const Eigen::MatrixXd& chunk) {
+  const char* what = "StreamingZeroPhaseFilter::push";
+  if (finished_) throw InputError(std::string(what) + ": the signal was finished; reset() first");
+  detail::require_columns(chunk, channels_, what);
+  detail::require_finite(chunk, n_in_, what);
+  // Checks done: from here on the state changes.
+  if (chunk.rows() == 0) return Eigen::MatrixXd(0, channels_);
+  keep_raw_tail(chunk);
+  const bool started = n_in_ > padlen_;
+  n_in_ += chunk.rows();
+  if (started) {
+    forward_into_pending(chunk);
+  } else {
+    head_.conservativeResize(head_.rows() + chunk.rows(), Eigen::NoChange);
+    head_.bottomRows(chunk.rows()) = chunk;
+    if (n_in_ > padlen_) start_forward();
+  }
+  const Eigen::Index ready = pending_rows_ - overlap_;
+  return ready >= block_ ? release(ready) : Eigen::MatrixXd(0, channels_);
+}
+
+Eigen::MatrixXd StreamingZeroPhaseFilter::finish() {
+  if (finished_) throw InputError("StreamingZeroPhaseFilter::finish: already finished");
+  if (n_in_ <= padlen_)
+    throw InputError("StreamingZeroPhaseFilter::finish: the signal has " + std::to_string(n_in_) +
+                     " samples; the edge padding needs more than " + std::to_string(padlen_));
+  Eigen::MatrixXd out(pending_rows_, channels_);
+  Eigen::VectorXd pad(padlen_);
+  Eigen::VectorXd z(unit_state_.size());
+  for (Eigen::Index c = 0; c < channels_; ++c) {
+    // The end exactly as the offline filter: forward through the odd extension, then back
+    // from its steady state over the extension and every sample not yet released.
+    detail::odd_pad_end(raw_tail_.col(c).data(), raw_tail_.rows(), padlen_, pad.data());
+    detail::run_forward(sos_, forward_state_.col(c).data(), pad.data(), padlen_);
+    z = unit_state_ * pad(padlen_ - 1);
+    detail::run_backward(sos_, z.data(), pad.data(), padlen_);
+    out.col(c) = pending_.col(c).head(pending_rows_);
+    detail::run_backward(sos_, z.data(), out.col(c).data(), pending_rows_);
+  }
+  n_out_ += pending_rows_;
+  pending_rows_ = 0;
+  pending_.resize(0, channels_);
+  finished_ = true;
+  return out;
+}
+
+void StreamingZeroPhaseFilter::keep_raw_tail(const Eigen::MatrixXd& chunk) {
+  const Eigen::Index keep = padlen_ + 1;
+  if (chunk.rows() >= keep) {
+    raw_tail_ = chunk.bottomRows(keep);
+    return;
+  }
+  Eigen::MatrixXd joined(raw_tail_.rows() + chunk.rows(), channels_);
+  joined << raw_tail_, chunk;
+  raw_tail_ = joined.bottomRows(std::min(keep, joined.rows()));
+}
+
+void StreamingZeroPhaseFilter::start_forward() {
+  // The odd extension before the start needs x[0..padlen]: the forward pass waits for it.
+  Eigen::VectorXd pad(padlen_);
+  for (Eigen::Index c = 0; c < channels_; ++c) {
+    detail::odd_pad_start(head_.col(c).data(), padlen_, pad.data());
+    forward_state_.col(c) = unit_state_ * pad(0);
+    detail::run_forward(sos_, forward_state_.col(c).data(), pad.data(), padlen_);
+  }
+  const Eigen::MatrixXd head = std::move(head_);
+  head_.resize(0, channels_);
+  forward_into_pending(head);
+}
+
+void StreamingZeroPhaseFilter::forward_into_pending(const Eigen::MatrixXd& x) {
+  const Eigen::Index m = x.rows();
+  if (pending_.rows() < pending_rows_ + m)
+    pending_.conservativeResize(std::max(2 * pending_.rows(), pending_rows_ + m), Eigen::NoChange);
+  pending_.middleRows(pending_rows_, m) = x;
+  for (Eigen::Index c = 0; c < channels_; ++c)
+    detail::run_forward(sos_, forward_state_.col(c).data(), pending_.col(c).data() + pending_rows_,
+                        m);
+  pending_rows_ += m;
+}
+
+Eigen::MatrixXd StreamingZeroPhaseFilter::release(Eigen::Index count) {
+  // Backward from the newest forward output, started in steady state for its value: at least
+  // `overlap` samples of decay separate that start from every released sample.
+  Eigen::MatrixXd out(count, channels_);
+  Eigen::VectorXd sweep(pending_rows_);
+  Eigen::VectorXd z(unit_state_.size());
+  for (Eigen::Index c = 0; c < channels_; ++c) {
+    sweep = pending_.col(c).head(pending_rows_);
+    z = unit_state_ * sweep(pending_rows_ - 1);
+    detail::run_backward(sos_, z.data(), sweep.data(), pending_rows_);
+    out.col(c) = sweep.head(count);
+  }
+  const Eigen::Index left = pending_rows_ - count;
+  pending_.topRows(left) = pending_.middleRows(count, left).eval();
+  pending_rows_ = left;
+  n_out_ += count;
+  const Eigen::Index usual = 2 * (overlap_ + block_);
+  if (pending_.rows() > 2 * usual) pending_.conservativeResize(usual, Eigen::NoChange);
+  return out;
+}
+
+}  // namespace dynid::signal
