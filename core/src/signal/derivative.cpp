@@ -1,0 +1,76 @@
+#include "dynid/signal/derivative.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "checks.hpp"
+#include "dynid/error.hpp"
+
+namespace dynid::signal {
+
+StreamingDerivative::StreamingDerivative(Eigen::Index channels, double sample_period)
+    : channels_(channels), period_(sample_period) {
+  detail::require_channel_count(channels, "StreamingDerivative");
+  detail::require_sample_period(sample_period, "StreamingDerivative");
+  reset();
+}
+
+void StreamingDerivative::reset() {
+  recent_.resize(0, channels_);
+  n_in_ = 0;
+  n_out_ = 0;
+  finished_ = false;
+}
+
+Eigen::MatrixXd StreamingDerivative::push(const Eigen::MatrixXd& chunk) {
+  const char* what = "StreamingDerivative::push";
+  if (finished_) throw InputError(std::string(what) + ": the signal was finished; reset() first");
+  detail::require_columns(chunk, channels_, what);
+  detail::require_finite(chunk, n_in_, what);
+  // w: the recent samples then the chunk; w.row(i) is sample first + i of the stream.
+  Eigen::MatrixXd w(recent_.rows() + chunk.rows(), channels_);
+  w << recent_, chunk;
+  const Eigen::Index first = n_in_ - recent_.rows();
+  n_in_ += chunk.rows();
+  const Eigen::Index final_count = n_in_ >= 3 ? n_in_ - 1 : 0;  // x'[k] final once x[k+1] is in
+  Eigen::MatrixXd out(final_count - n_out_, channels_);
+  const double half = 0.5 / period_;
+  for (Eigen::Index k = n_out_; k < final_count; ++k) {
+    const Eigen::Index i = k - first;
+    if (k == 0)
+      out.row(0) = (-3.0 * w.row(i) + 4.0 * w.row(i + 1) - w.row(i + 2)) * half;
+    else
+      out.row(k - n_out_) = (w.row(i + 1) - w.row(i - 1)) * half;
+  }
+  n_out_ = final_count;
+  recent_ = w.bottomRows(std::min<Eigen::Index>(3, w.rows()));
+  return out;
+}
+
+Eigen::MatrixXd StreamingDerivative::finish() {
+  const char* what = "StreamingDerivative::finish";
+  if (finished_) throw InputError(std::string(what) + ": already finished");
+  if (n_in_ < 3)
+    throw InputError(std::string(what) + ": the signal has " + std::to_string(n_in_) +
+                     " samples; a second-order derivative needs at least 3");
+  const auto& r = recent_;  // x[n-3], x[n-2], x[n-1]
+  Eigen::MatrixXd out = (3.0 * r.row(2) - 4.0 * r.row(1) + r.row(0)) * (0.5 / period_);
+  ++n_out_;
+  finished_ = true;
+  return out;
+}
+
+Eigen::MatrixXd derivative(const Eigen::MatrixXd& x, double sample_period) {
+  detail::require_sample_period(sample_period, "derivative");
+  if (x.rows() < 3)
+    throw InputError("derivative: the signal has " + std::to_string(x.rows()) +
+                     " samples; a second-order derivative needs at least 3");
+  if (x.cols() == 0) return Eigen::MatrixXd(x.rows(), 0);
+  StreamingDerivative d(x.cols(), sample_period);
+  Eigen::MatrixXd y(x.rows(), x.cols());
+  y.topRows(x.rows() - 1) = d.push(x);
+  y.bottomRows(1) = d.finish();
+  return y;
+}
+
+}  // namespace dynid::signal
