@@ -1,0 +1,50 @@
+#pragma once
+// ClutchSlipModel: the engine side of a slipping clutch (borsotto §1.3 eq. 4.15-4.16, §2.5
+// final mu model, §8.2 row V1):
+//
+//   T_e = J_e dw_e/dt + T_c,    T_c = Gamma_n mu(dw),   dw = w_e - w_in (slip speed),
+//   mu(dw) = mu_c sgn dw + (mu_s - mu_c) exp(-(dw/v_s)^2) sgn dw + mu_v dw   (Stribeck, d_s = 2)
+//
+// Gamma_n = clutch_clamp_load * clutch_friction_radius (the equivalent radius R_eq of
+// borsotto §2.5 times the number of friction faces). One group "engine": y = engine_torque,
+// columns [d_engine_speed, Gamma_n sgn dw] for [engine_inertia (kg m^2), coulomb_friction mu_c
+// (-)]; the effects viscous_friction (Gamma_n dw, mu_v in s/rad) and stribeck_friction
+// (Gamma_n exp(-(dw/v_s)^2) sgn dw, mu_s - mu_c) complete borsotto's Stribeck model. v_s enters
+// nonlinearly: it is a constant of the model, chosen by StribeckSpeedBank (stribeck_bank.hpp)
+// among candidates by minimum residual (borsotto §8.4).
+// Rows left out: |dw| < min_slip_speed (sgn undefined: the clutch sticks; borsotto's dv).
+//
+// Constants: clutch_friction_radius (m); optional stribeck_speed (rad/s; without it the
+// stribeck_friction effect is not offered), min_slip_speed (rad/s, 1e-3).
+// Effects: viscous_friction, stribeck_friction, engine_torque_offset (ECU torque = true - T0).
+#include <optional>
+
+#include "dynid/model/constants.hpp"
+#include "dynid/model/row_model.hpp"
+
+namespace dynid::model {
+
+class ClutchSlipModel final : public RowModel {
+ public:
+  explicit ClutchSlipModel(const Constants& constants);
+
+  std::string name() const override { return "clutch_slip"; }
+  std::vector<ParameterInfo> parameters() const override;
+  std::vector<ChannelNeed> channels() const override;
+  std::vector<std::string> groups() const override { return {"engine"}; }
+  std::optional<double> stribeck_speed() const { return stribeck_speed_; }
+
+ protected:
+  std::vector<EffectDefinition> effect_definitions() const override;
+  RowFn bind(const ChannelSet& channels, const std::vector<std::string>& effects) const override;
+
+ private:
+  // A column Gamma_n * law(slip).
+  EffectDefinition friction_effect(Effect info, std::function<double(double)> law) const;
+
+  double radius_;
+  std::optional<double> stribeck_speed_;
+  double min_slip_;
+};
+
+}  // namespace dynid::model

@@ -1,0 +1,67 @@
+#pragma once
+// LongitudinalModel: the vehicle's longitudinal force balance from CAN signals
+// (nehaoua §6 and §10.4; venture §10 "longitudinal row"; borsotto §1.6 road load):
+//
+//   M dvx/dt = F_drive - 1/2 rho SCx vx|vx| - F_r sgn(vx)              (flat road, no braking)
+//
+//   F_drive = eta^s T_e G / r_w     source kEngineTorque: engine_torque T_e, gear_ratio G (engine
+//                                   to wheel), s = +1 when T_e >= 0 and -1 when the engine
+//                                   drags (power flows back through the driveline);
+//                                   zero in neutral (gear 0, when `gear` is present);
+//   F_drive = T_w / r_w             source kWheelTorque: wheel_torque T_w (driven wheels' sum).
+//
+// One group "longitudinal": y = F_drive, columns [d_vx, 1/2 rho vx|vx|, sgn vx] for the
+// parameters [mass (kg), SCx (m^2), rolling_resistance F_r (N)]; the rolling-resistance
+// coefficient is F_r / (M g). d_vx is the derivative of the wheel-speed-based vx, so on a slope
+// the residual is M g sin(grade) (candidate effects road_grade, road_grade_accelerometer).
+//
+// Rows left out: |vx| < min_speed (sgn vx undefined, drag laws invalid at standstill); braking
+// (brake_pressure > brake_pressure_threshold) unless brake_drag is enabled, since the brake
+// force is not in the model; for the engine source, a slipping clutch (|engine_speed -
+// gearbox_input_speed| > clutch_slip_tolerance, when both channels are present), since the
+// engine torque then does not reach the wheels.
+//
+// Constants: wheel_radius (m), air_density (kg/m^3), driveline_efficiency (engine source,
+// 0 < eta <= 1); optional gravity (9.80665), min_speed (1 m/s), brake_pressure_threshold
+// (2e4 Pa), clutch_slip_tolerance (1 rad/s).
+// Effects: road_grade, road_grade_accelerometer, linear_drag, brake_drag; engine source also
+// engine_torque_offset and rotating_inertia (engine inertia seen through the gear: per-gear
+// equivalent mass M + eta J_e G^2 / r_w^2).
+#include "dynid/model/constants.hpp"
+#include "dynid/model/row_model.hpp"
+
+namespace dynid::model {
+
+class LongitudinalModel final : public RowModel {
+ public:
+  enum class Source { kEngineTorque, kWheelTorque };
+  LongitudinalModel(const Constants& constants, Source source);
+
+  std::string name() const override;
+  std::vector<ParameterInfo> parameters() const override;
+  std::vector<ChannelNeed> channels() const override;
+  std::vector<std::string> groups() const override { return {"longitudinal"}; }
+
+ protected:
+  std::vector<EffectDefinition> effect_definitions() const override;
+  RowFn bind(const ChannelSet& channels, const std::vector<std::string>& effects) const override;
+
+ private:
+  // The per-sample drive force and its factor F_drive / T (eta^s G / r_w or 1 / r_w).
+  struct Drive {
+    double force;
+    double factor;
+  };
+  std::function<Drive(Eigen::Index)> drive(const ChannelSet& channels) const;
+
+  Source source_;
+  double wheel_radius_;
+  double air_density_;
+  double efficiency_ = 1.0;
+  double gravity_;
+  double min_speed_;
+  double brake_threshold_;
+  double slip_tolerance_;
+};
+
+}  // namespace dynid::model

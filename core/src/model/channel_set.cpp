@@ -1,0 +1,65 @@
+#include "dynid/model/channel_set.hpp"
+
+#include <cmath>
+
+#include "dynid/error.hpp"
+
+namespace dynid::model {
+
+ChannelSet::ChannelSet(double sample_period, Eigen::Index samples)
+    : sample_period_(sample_period), samples_(samples) {
+  if (!std::isfinite(sample_period) || sample_period <= 0.0)
+    throw InputError("channel set: sample period " + std::to_string(sample_period) +
+                     " s is not a positive finite number");
+  if (samples < 0)
+    throw InputError("channel set: negative sample count " + std::to_string(samples));
+  valid_.assign(static_cast<std::size_t>(samples), true);
+}
+
+void ChannelSet::add(const std::string& name, const std::string& unit, Eigen::VectorXd values) {
+  if (name.empty()) throw InputError("channel set: a channel name is empty");
+  if (has(name)) throw InputError("channel set: duplicate channel '" + name + "'");
+  if (values.size() != samples_)
+    throw InputError("channel set: channel '" + name + "' has " + std::to_string(values.size()) +
+                     " samples, the set has " + std::to_string(samples_));
+  for (Eigen::Index k = 0; k < samples_; ++k)
+    if (valid(k) && !std::isfinite(values(k)))
+      throw InputError("channel set: channel '" + name + "' is not finite at sample " +
+                       std::to_string(k) + " (mark the stretch invalid first)");
+  channels_.emplace(name, Channel{unit, std::move(values)});
+}
+
+const Eigen::VectorXd& ChannelSet::operator[](const std::string& name) const {
+  const auto it = channels_.find(name);
+  if (it == channels_.end()) throw InputError("channel set: no channel '" + name + "'");
+  return it->second.values;
+}
+
+const std::string& ChannelSet::unit(const std::string& name) const {
+  const auto it = channels_.find(name);
+  if (it == channels_.end()) throw InputError("channel set: no channel '" + name + "'");
+  return it->second.unit;
+}
+
+std::vector<std::string> ChannelSet::names() const {
+  std::vector<std::string> out;
+  out.reserve(channels_.size());
+  for (const auto& [name, channel] : channels_) out.push_back(name);
+  return out;
+}
+
+void ChannelSet::invalidate(Eigen::Index first, Eigen::Index count) {
+  if (first < 0 || count < 0 || first > samples_ - count)
+    throw InputError("channel set: invalid range [" + std::to_string(first) + ", " +
+                     std::to_string(first) + " + " + std::to_string(count) + ") of " +
+                     std::to_string(samples_) + " samples");
+  for (Eigen::Index k = first; k < first + count; ++k) valid_[static_cast<std::size_t>(k)] = false;
+}
+
+Eigen::Index ChannelSet::valid_count() const {
+  Eigen::Index n = 0;
+  for (const bool v : valid_) n += v ? 1 : 0;
+  return n;
+}
+
+}  // namespace dynid::model

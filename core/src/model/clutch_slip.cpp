@@ -1,0 +1,88 @@
+#include "dynid/model/clutch_slip.hpp"
+
+#include <cmath>
+
+#include "dynid/model/effects.hpp"
+#include "support.hpp"
+
+namespace dynid::model {
+
+using detail::parameter;
+
+ClutchSlipModel::ClutchSlipModel(const Constants& constants) {
+  const ConstantReader c(constants, name());
+  radius_ = c.positive("clutch_friction_radius", "m, R_eq times the number of friction faces");
+  if (c.optional("stribeck_speed"))
+    stribeck_speed_ = c.positive("stribeck_speed", "rad/s, Stribeck speed v_s");
+  min_slip_ = c.positive_or("min_slip_speed", 1e-3);
+}
+
+std::vector<ParameterInfo> ClutchSlipModel::parameters() const {
+  return {parameter("engine_inertia", "kg m^2", "engine and flywheel inertia J_e"),
+          parameter("coulomb_friction", "-", "Coulomb friction coefficient mu_c")};
+}
+
+std::vector<ChannelNeed> ClutchSlipModel::channels() const {
+  return {{"engine_speed", "rad/s"},
+          {"d_engine_speed", "rad/s^2"},
+          {"engine_torque", "N m"},
+          {"gearbox_input_speed", "rad/s"},
+          {"clutch_clamp_load", "N"}};
+}
+
+RowModel::EffectDefinition ClutchSlipModel::friction_effect(Effect info,
+                                                            std::function<double(double)> law) const {
+  return detail::one_column(
+      std::move(info), [law = std::move(law), radius = radius_](const ChannelSet& set) {
+        const Eigen::VectorXd& we = set["engine_speed"];
+        const Eigen::VectorXd& wi = set["gearbox_input_speed"];
+        const Eigen::VectorXd& load = set["clutch_clamp_load"];
+        return detail::ValueFn([&we, &wi, &load, law, radius](Eigen::Index k) {
+          return load(k) * radius * law(we(k) - wi(k));
+        });
+      });
+}
+
+std::vector<RowModel::EffectDefinition> ClutchSlipModel::effect_definitions() const {
+  std::vector<EffectDefinition> out{
+      friction_effect({effect::kViscous, "viscous friction Gamma_n mu_v dw",
+                       {parameter("viscous_friction", "s/rad", "mu_v")},
+                       {}},
+                      [](double slip) { return slip; }),
+      detail::one_column({effect::kTorqueOffset, "ECU engine torque offset (true = ECU + T0)",
+                          {parameter("engine_torque_offset", "N m", "T0", 0.0)},
+                          {}},
+                         [](const ChannelSet&) {
+                           return detail::ValueFn([](Eigen::Index) { return -1.0; });
+                         })};
+  if (!stribeck_speed_) return out;
+  const double vs = *stribeck_speed_;
+  out.push_back(friction_effect(
+      {effect::kStribeck,
+       "Stribeck friction Gamma_n (mu_s - mu_c) exp(-(dw/v_s)^2) sgn dw, v_s = " +
+           std::to_string(vs) + " rad/s",
+       {parameter("stribeck_friction", "-", "mu_s - mu_c")},
+       {}},
+      [vs](double slip) { return std::exp(-(slip / vs) * (slip / vs)) * detail::sgn(slip); }));
+  return out;
+}
+
+RowModel::RowFn ClutchSlipModel::bind(const ChannelSet& set,
+                                      const std::vector<std::string>&) const {
+  const Eigen::VectorXd& we = set["engine_speed"];
+  const Eigen::VectorXd& dwe = set["d_engine_speed"];
+  const Eigen::VectorXd& te = set["engine_torque"];
+  const Eigen::VectorXd& wi = set["gearbox_input_speed"];
+  const Eigen::VectorXd& load = set["clutch_clamp_load"];
+  return [&, radius = radius_, min = min_slip_](Eigen::Index k, std::size_t, double* w,
+                                                 double& y) {
+    const double slip = we(k) - wi(k);
+    if (std::abs(slip) < min) return false;
+    w[0] = dwe(k);
+    w[1] = load(k) * radius * detail::sgn(slip);
+    y = te(k);
+    return true;
+  };
+}
+
+}  // namespace dynid::model

@@ -1,0 +1,78 @@
+#include "dynid/model/kinematic.hpp"
+
+#include <cmath>
+
+#include "dynid/model/effects.hpp"
+#include "support.hpp"
+
+namespace dynid::model {
+
+using detail::parameter;
+
+KinematicModel::KinematicModel(const Constants& constants, Axis axis) : axis_(axis) {
+  gravity_ = ConstantReader(constants, name()).positive_or("gravity", detail::kStandardGravity);
+}
+
+std::string KinematicModel::name() const {
+  return axis_ == Axis::kLongitudinal ? "kinematic_longitudinal" : "kinematic_lateral";
+}
+
+std::vector<std::string> KinematicModel::groups() const {
+  return {axis_ == Axis::kLongitudinal ? "longitudinal" : "lateral"};
+}
+
+std::vector<ParameterInfo> KinematicModel::parameters() const {
+  return {parameter("sensor_scale", "-", "accelerometer gain over speed scale", 1.0),
+          parameter("sensor_offset", "m/s^2", "accelerometer offset", 0.0)};
+}
+
+std::vector<ChannelNeed> KinematicModel::channels() const {
+  if (axis_ == Axis::kLongitudinal)
+    return {{"ax", "m/s^2"}, {"d_vx", "m/s^2"}, {"road_grade", "rad", true}};
+  return {{"ay", "m/s^2"},
+          {"d_vy", "m/s^2"},
+          {"vx", "m/s"},
+          {"yaw_rate", "rad/s"},
+          {"road_bank", "rad", true}};
+}
+
+std::vector<RowModel::EffectDefinition> KinematicModel::effect_definitions() const {
+  const bool lon = axis_ == Axis::kLongitudinal;
+  const std::string channel = lon ? "road_grade" : "road_bank";
+  const double g = gravity_;
+  return {detail::one_column(
+      {lon ? effect::kRoadGrade : effect::kRoadBank,
+       "gravity along the axis: g sin(" + channel + ")",
+       {parameter(lon ? "grade_gain" : "bank_gain", "-", "gain on g sin(angle)", 1.0)},
+       {channel}},
+      [channel, g](const ChannelSet& set) -> detail::ValueFn {
+        const Eigen::VectorXd& angle = set[channel];
+        return [&angle, g](Eigen::Index k) { return g * std::sin(angle(k)); };
+      })};
+}
+
+RowModel::RowFn KinematicModel::bind(const ChannelSet& set,
+                                     const std::vector<std::string>&) const {
+  if (axis_ == Axis::kLongitudinal) {
+    const Eigen::VectorXd& ax = set["ax"];
+    const Eigen::VectorXd& dvx = set["d_vx"];
+    return [&ax, &dvx](Eigen::Index k, std::size_t, double* w, double& y) {
+      w[0] = dvx(k);
+      w[1] = 1.0;
+      y = ax(k);
+      return true;
+    };
+  }
+  const Eigen::VectorXd& ay = set["ay"];
+  const Eigen::VectorXd& dvy = set["d_vy"];
+  const Eigen::VectorXd& vx = set["vx"];
+  const Eigen::VectorXd& r = set["yaw_rate"];
+  return [&ay, &dvy, &vx, &r](Eigen::Index k, std::size_t, double* w, double& y) {
+    w[0] = dvy(k) + r(k) * vx(k);
+    w[1] = 1.0;
+    y = ay(k);
+    return true;
+  };
+}
+
+}  // namespace dynid::model

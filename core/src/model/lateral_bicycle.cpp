@@ -1,0 +1,108 @@
+#include "dynid/model/lateral_bicycle.hpp"
+
+#include <cmath>
+
+#include "dynid/model/effects.hpp"
+#include "support.hpp"
+
+namespace dynid::model {
+
+using detail::parameter;
+
+LateralBicycleModel::LateralBicycleModel(const Constants& constants) {
+  const ConstantReader c(constants, name());
+  a_ = c.positive("a", "m, CG to front axle");
+  b_ = c.positive("b", "m, CG to rear axle");
+  mass_ = c.optional("mass");
+  if (mass_) mass_ = c.positive("mass", "kg, known vehicle mass");
+  imu_x_ = c.optional("imu_x").value_or(0.0);
+  min_speed_ = c.positive_or("min_speed", 1.0);
+}
+
+ParameterInfo LateralBicycleModel::scaled(ParameterInfo p) const {
+  if (mass_) return p;
+  p.name += "_per_mass";
+  p.unit += "/kg";
+  p.description += ", per unit mass";
+  return p;
+}
+
+std::vector<ParameterInfo> LateralBicycleModel::parameters() const {
+  return {scaled(parameter("yaw_inertia", "kg m^2", "yaw inertia at the CG")),
+          scaled(parameter("front_cornering_stiffness", "N/rad", "front axle (both tyres)")),
+          scaled(parameter("rear_cornering_stiffness", "N/rad", "rear axle (both tyres)"))};
+}
+
+std::vector<ChannelNeed> LateralBicycleModel::channels() const {
+  return {{"vx", "m/s"},         {"vy", "m/s"},           {"ay", "m/s^2"},
+          {"yaw_rate", "rad/s"}, {"d_yaw_rate", "rad/s^2"}, {"steer", "rad"}};
+}
+
+std::function<LateralBicycleModel::Slip(Eigen::Index)> LateralBicycleModel::slip(
+    const ChannelSet& set) const {
+  const Eigen::VectorXd& vx = set["vx"];
+  const Eigen::VectorXd& vy = set["vy"];
+  const Eigen::VectorXd& r = set["yaw_rate"];
+  const Eigen::VectorXd& steer = set["steer"];
+  return [&, a = a_, b = b_](Eigen::Index k) {
+    return Slip{steer(k) - std::atan((vy(k) + a * r(k)) / vx(k)),
+                -std::atan((vy(k) - b * r(k)) / vx(k)), std::cos(steer(k))};
+  };
+}
+
+RowModel::EffectDefinition LateralBicycleModel::axle_effect(Effect info,
+                                                            std::function<double(double)> law,
+                                                            bool rear) const {
+  EffectDefinition def{std::move(info), {}};
+  def.bind = [this, law = std::move(law), rear](const ChannelSet& set) -> ColumnFn {
+    return [s = slip(set), law, rear, a = a_, b = b_](Eigen::Index k, std::size_t g,
+                                                      double* out) {
+      const Slip v = s(k);
+      const double front = law(v.front) * v.cos_steer;
+      const double back = law(v.rear);
+      out[0] = g == 0 ? front : -a * front;
+      if (rear) out[1] = g == 0 ? back : b * back;
+      return true;
+    };
+  };
+  return def;
+}
+
+std::vector<RowModel::EffectDefinition> LateralBicycleModel::effect_definitions() const {
+  return {axle_effect({effect::kSteerOffset, "steer sensor offset d0: a front force C_f d0",
+                       {scaled(parameter("steer_offset_force", "N", "C_f times the offset", 0.0))},
+                       {}},
+                      [](double) { return 1.0; }, false),
+          axle_effect({effect::kTyreSaturation,
+                       "Fiala tyre before saturation: F_y = C d - C^2/(3 mu F_z) |d| d",
+                       {scaled(parameter("front_tyre_saturation", "N/rad^2", "|d| d coefficient")),
+                        scaled(parameter("rear_tyre_saturation", "N/rad^2", "|d| d coefficient"))},
+                       {}},
+                      detail::signed_square, true)};
+}
+
+RowModel::RowFn LateralBicycleModel::bind(const ChannelSet& set,
+                                          const std::vector<std::string>&) const {
+  const Eigen::VectorXd& vx = set["vx"];
+  const Eigen::VectorXd& ay = set["ay"];
+  const Eigen::VectorXd& dr = set["d_yaw_rate"];
+  const double scale = mass_.value_or(1.0);
+  return [=, this, &vx, &ay, &dr, s = slip(set)](Eigen::Index k, std::size_t group, double* w,
+                                                  double& y) {
+    if (vx(k) < min_speed_) return false;
+    const Slip v = s(k);
+    if (group == 0) {
+      w[1] = v.front * v.cos_steer;
+      w[2] = v.rear;
+      y = scale * (ay(k) - imu_x_ * dr(k));
+    } else {
+      w[0] = dr(k);
+      w[1] = -a_ * v.front * v.cos_steer;
+      w[2] = b_ * v.rear;
+      y = 0.0;
+    }
+    return true;
+  };
+}
+
+}  // namespace dynid::model

@@ -1,0 +1,145 @@
+#include "dynid/model/longitudinal.hpp"
+
+#include <cmath>
+
+#include "dynid/error.hpp"
+#include "dynid/model/effects.hpp"
+#include "support.hpp"
+
+namespace dynid::model {
+
+using detail::parameter;
+
+LongitudinalModel::LongitudinalModel(const Constants& constants, Source source) : source_(source) {
+  const ConstantReader c(constants, name());
+  wheel_radius_ = c.positive("wheel_radius", "m, rolling radius of the driven wheels");
+  air_density_ = c.positive("air_density", "kg/m^3");
+  if (source_ == Source::kEngineTorque) {
+    efficiency_ = c.positive("driveline_efficiency", "engine to wheel, 0 < eta <= 1");
+    if (efficiency_ > 1.0)
+      throw InputError("model '" + name() + "': constant 'driveline_efficiency' > 1");
+  }
+  gravity_ = c.positive_or("gravity", detail::kStandardGravity);
+  min_speed_ = c.positive_or("min_speed", 1.0);
+  brake_threshold_ = c.positive_or("brake_pressure_threshold", 2e4);
+  slip_tolerance_ = c.positive_or("clutch_slip_tolerance", 1.0);
+}
+
+std::string LongitudinalModel::name() const {
+  return source_ == Source::kEngineTorque ? "longitudinal_engine" : "longitudinal_wheel";
+}
+
+std::vector<ParameterInfo> LongitudinalModel::parameters() const {
+  return {parameter("mass", "kg", "vehicle mass (translating)"),
+          parameter("SCx", "m^2", "aerodynamic drag area S Cx"),
+          parameter("rolling_resistance", "N", "rolling resistance force F_r = C_rr M g")};
+}
+
+std::vector<ChannelNeed> LongitudinalModel::channels() const {
+  std::vector<ChannelNeed> out{{"vx", "m/s"}, {"d_vx", "m/s^2"}};
+  if (source_ == Source::kEngineTorque) {
+    out.push_back({"engine_torque", "N m"});
+    out.push_back({"gear_ratio", "-"});
+    out.push_back({"gear", "-", true});
+    out.push_back({"engine_speed", "rad/s", true});
+    out.push_back({"gearbox_input_speed", "rad/s", true});
+  } else {
+    out.push_back({"wheel_torque", "N m"});
+  }
+  out.push_back({"brake_pressure", "Pa", true});
+  out.push_back({"road_grade", "rad", true});
+  out.push_back({"ax", "m/s^2", true});
+  return out;
+}
+
+std::function<LongitudinalModel::Drive(Eigen::Index)> LongitudinalModel::drive(
+    const ChannelSet& set) const {
+  const double r = wheel_radius_;
+  if (source_ == Source::kWheelTorque) {
+    const Eigen::VectorXd& t = set["wheel_torque"];
+    return [&t, r](Eigen::Index k) { return Drive{t(k) / r, 1.0 / r}; };
+  }
+  const Eigen::VectorXd& t = set["engine_torque"];
+  const Eigen::VectorXd& ratio = set["gear_ratio"];
+  const Eigen::VectorXd* gear = detail::find(set, "gear");
+  const double eta = efficiency_;
+  return [&t, &ratio, gear, eta, r](Eigen::Index k) {
+    if (gear != nullptr && std::lround((*gear)(k)) == 0) return Drive{0.0, 0.0};
+    // Driving, the driveline loses (1 - eta) of the engine's power; dragging, of the wheels'.
+    const double factor = (t(k) >= 0.0 ? eta : 1.0 / eta) * ratio(k) / r;
+    return Drive{t(k) * factor, factor};
+  };
+}
+
+std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() const {
+  const double g = gravity_;
+  std::vector<EffectDefinition> out{
+      detail::one_column(
+          {effect::kRoadGrade, "grade load M g sin(grade) from the road_grade channel",
+           {parameter("grade_mass", "kg", "mass seen by the grade (= mass if grade explains it)")},
+           {"road_grade"}},
+          [g](const ChannelSet& set) -> detail::ValueFn {
+            const Eigen::VectorXd& grade = set["road_grade"];
+            return [&grade, g](Eigen::Index k) { return g * std::sin(grade(k)); };
+          }),
+      detail::one_column(
+          {effect::kRoadGradeAccelerometer,
+           "grade load M (ax - d_vx): the accelerometer sees g sin(grade), the wheels do not",
+           {parameter("grade_mass_accelerometer", "kg", "mass seen by the grade")},
+           {"ax"}},
+          [](const ChannelSet& set) -> detail::ValueFn {
+            const Eigen::VectorXd& ax = set["ax"];
+            const Eigen::VectorXd& dvx = set["d_vx"];
+            return [&ax, &dvx](Eigen::Index k) { return ax(k) - dvx(k); };
+          }),
+      detail::one_column({effect::kLinearDrag, "resistance proportional to speed (tyre losses)",
+                          {parameter("linear_drag", "N s/m", "speed-proportional resistance")},
+                          {}},
+                         [](const ChannelSet& set) { return detail::channel(set, "vx"); }),
+      detail::brake_drag("brake_force_gain", "N/Pa")};
+  if (source_ != Source::kEngineTorque) return out;
+  auto factor = [this](const ChannelSet& set) { return drive(set); };
+  out.push_back(detail::one_column(
+      {effect::kTorqueOffset, "engine torque sensor offset T0: F_drive = eta G (T + T0) / r_w",
+       {parameter("engine_torque_offset", "N m", "offset of the ECU torque", 0.0)},
+       {}},
+      [factor](const ChannelSet& set) -> detail::ValueFn {
+        return [d = factor(set)](Eigen::Index k) { return -d(k).factor; };
+      }));
+  const double r = wheel_radius_;
+  out.push_back(detail::one_column(
+      {effect::kRotatingInertia, "engine inertia through the gear: eta J_e G^2 / r_w^2 d_vx",
+       {parameter("engine_inertia", "kg m^2", "rotating inertia on the engine side")},
+       {}},
+      [factor, r](const ChannelSet& set) -> detail::ValueFn {
+        const Eigen::VectorXd& ratio = set["gear_ratio"];
+        const Eigen::VectorXd& dvx = set["d_vx"];
+        return [d = factor(set), &ratio, &dvx, r](Eigen::Index k) {
+          return d(k).factor * ratio(k) / r * dvx(k);
+        };
+      }));
+  return out;
+}
+
+RowModel::RowFn LongitudinalModel::bind(const ChannelSet& set,
+                                        const std::vector<std::string>& effects) const {
+  const Eigen::VectorXd& vx = set["vx"];
+  const Eigen::VectorXd& dvx = set["d_vx"];
+  const Eigen::VectorXd* engine = detail::find(set, "engine_speed");
+  const Eigen::VectorXd* input = detail::find(set, "gearbox_input_speed");
+  const bool slip_check = source_ == Source::kEngineTorque && engine != nullptr && input != nullptr;
+  auto braking = detail::braking(set, brake_threshold_, enabled(effects, effect::kBrakeDrag));
+  const double half_rho = 0.5 * air_density_;
+  return [=, this, &vx, &dvx, drive = drive(set)](Eigen::Index k, std::size_t, double* w,
+                                                   double& y) {
+    if (std::abs(vx(k)) < min_speed_ || braking(k)) return false;
+    if (slip_check && std::abs((*engine)(k) - (*input)(k)) > slip_tolerance_) return false;
+    w[0] = dvx(k);
+    w[1] = half_rho * detail::signed_square(vx(k));
+    w[2] = detail::sgn(vx(k));
+    y = drive(k).force;
+    return true;
+  };
+}
+
+}  // namespace dynid::model

@@ -1,0 +1,129 @@
+#include "dynid/model/row_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dictionary.hpp"
+#include "dynid/error.hpp"
+#include "dynid/model/effects.hpp"
+
+namespace dynid::model {
+
+bool enabled(const std::vector<std::string>& effects, const std::string& name) {
+  return std::find(effects.begin(), effects.end(), name) != effects.end();
+}
+
+std::vector<Effect> RowModel::candidate_effects() const {
+  std::vector<Effect> out;
+  for (EffectDefinition& d : effect_definitions()) out.push_back(std::move(d.info));
+  return out;
+}
+
+void RowModel::check_channels(const ChannelSet& channels) const {
+  for (const ChannelNeed& need : this->channels()) {
+    if (!channels.has(need.name)) {
+      if (need.optional) continue;
+      throw InputError("model '" + name() + "': missing channel '" + need.name + "' (" +
+                       need.unit + ")");
+    }
+    if (channels.unit(need.name) != need.unit)
+      throw InputError("model '" + name() + "': channel '" + need.name + "' is in '" +
+                       channels.unit(need.name) + "', expected '" + need.unit + "'");
+  }
+}
+
+std::vector<RowModel::EffectDefinition> RowModel::resolve(
+    const ChannelSet& channels, const std::vector<std::string>& effects) const {
+  std::vector<EffectDefinition> own = effect_definitions();
+  std::vector<EffectDefinition> out;
+  for (std::size_t i = 0; i < effects.size(); ++i) {
+    const std::string& e = effects[i];
+    if (std::find(effects.begin(), effects.begin() + static_cast<std::ptrdiff_t>(i), e) !=
+        effects.begin() + static_cast<std::ptrdiff_t>(i))
+      throw InputError("model '" + name() + "': effect '" + e + "' enabled twice");
+    const auto it = std::find_if(own.begin(), own.end(),
+                                 [&](const EffectDefinition& d) { return d.info.name == e; });
+    if (it != own.end()) {
+      out.push_back(*it);
+    } else if (is_dictionary_effect(e)) {
+      out.push_back(detail::dictionary_definition(e, groups()));
+    } else {
+      std::string known;
+      for (const EffectDefinition& d : own) known += " " + d.info.name;
+      throw InputError("model '" + name() + "': unknown effect '" + e +
+                       "' (candidates:" + known + ", or dict:<op>:<channel>)");
+    }
+    for (const std::string& c : out.back().info.channels)
+      if (!channels.has(c))
+        throw InputError("model '" + name() + "': effect '" + e + "' needs channel '" + c + "'");
+  }
+  return out;
+}
+
+namespace {
+
+struct Bound {
+  std::vector<RowModel::ColumnFn> columns;
+  std::vector<std::size_t> widths;
+};
+
+GroupRows collect(const std::string& model, const std::string& group, std::size_t g,
+                  const ChannelSet& channels, const RowModel::RowFn& row, const Bound& effects,
+                  std::size_t base_width, std::size_t width) {
+  std::vector<double> data;  // row-major
+  std::vector<double> ys;
+  std::vector<Eigen::Index> samples;
+  std::vector<double> w(width);
+  for (Eigen::Index k = 0; k < channels.samples(); ++k) {
+    if (!channels.valid(k)) continue;
+    std::fill(w.begin(), w.end(), 0.0);
+    double y = 0.0;
+    if (!row(k, g, w.data(), y)) continue;
+    bool keep = true;
+    std::size_t offset = base_width;
+    for (std::size_t e = 0; keep && e < effects.columns.size(); ++e) {
+      keep = effects.columns[e](k, g, w.data() + offset);
+      offset += effects.widths[e];
+    }
+    if (!keep) continue;
+    const bool finite = std::isfinite(y) && std::all_of(w.begin(), w.end(), [](double v) {
+                          return std::isfinite(v);
+                        });
+    if (!finite)
+      throw InputError("model '" + model + "': group '" + group + "' has a non-finite row at " +
+                       "sample " + std::to_string(k) + " (mark bad samples invalid)");
+    data.insert(data.end(), w.begin(), w.end());
+    ys.push_back(y);
+    samples.push_back(k);
+  }
+  const auto m = static_cast<Eigen::Index>(ys.size());
+  const auto n = static_cast<Eigen::Index>(width);
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  GroupRows out{group, Eigen::Map<const RowMajor>(data.data(), m, n),
+                Eigen::Map<const Eigen::VectorXd>(ys.data(), m), std::move(samples)};
+  return out;
+}
+
+}  // namespace
+
+std::vector<GroupRows> RowModel::rows(const ChannelSet& channels,
+                                      const std::vector<std::string>& effects) const {
+  check_channels(channels);
+  const std::vector<EffectDefinition> defs = resolve(channels, effects);
+  const RowFn row = bind(channels, effects);
+  Bound bound;
+  const std::size_t base_width = parameters().size();
+  std::size_t width = base_width;
+  for (const EffectDefinition& d : defs) {
+    bound.columns.push_back(d.bind(channels));
+    bound.widths.push_back(d.info.parameters.size());
+    width += d.info.parameters.size();
+  }
+  const std::vector<std::string> names = groups();
+  std::vector<GroupRows> out;
+  for (std::size_t g = 0; g < names.size(); ++g)
+    out.push_back(collect(name(), names[g], g, channels, row, bound, base_width, width));
+  return out;
+}
+
+}  // namespace dynid::model

@@ -1,0 +1,53 @@
+#include "support.hpp"
+
+#include "dynid/error.hpp"
+
+namespace dynid::model::detail {
+
+RowModel::EffectDefinition one_column(Effect info, std::function<ValueFn(const ChannelSet&)> bind,
+                                      std::size_t group) {
+  RowModel::EffectDefinition def{std::move(info), {}};
+  def.bind = [bind = std::move(bind), group](const ChannelSet& set) -> RowModel::ColumnFn {
+    ValueFn value = bind(set);
+    return [value = std::move(value), group](Eigen::Index k, std::size_t g, double* out) {
+      if (g == group) out[0] = value(k);
+      return true;
+    };
+  };
+  return def;
+}
+
+}  // namespace dynid::model::detail
+
+namespace dynid::model::detail {
+
+std::function<bool(Eigen::Index)> braking(const ChannelSet& set, double threshold, bool allowed) {
+  const Eigen::VectorXd* p = find(set, "brake_pressure");
+  if (p == nullptr || allowed) return [](Eigen::Index) { return false; };
+  return [p, threshold](Eigen::Index k) { return (*p)(k) > threshold; };
+}
+
+ValueFn channel(const ChannelSet& set, const std::string& name) {
+  const Eigen::VectorXd& x = set[name];
+  return [&x](Eigen::Index k) { return x(k); };
+}
+
+RowModel::EffectDefinition brake_drag(const std::string& parameter_name, const std::string& unit) {
+  return one_column({"brake_drag", "brake force or torque proportional to brake pressure",
+                     {parameter(parameter_name, unit, "brake gain")}, {"brake_pressure"}},
+                    [](const ChannelSet& set) { return channel(set, "brake_pressure"); });
+}
+
+}  // namespace dynid::model::detail
+
+namespace dynid::model::detail {
+
+std::string opposite_corner(const std::string& corner, const std::string& model) {
+  if (corner == "fl") return "fr";
+  if (corner == "fr") return "fl";
+  if (corner == "rl") return "rr";
+  if (corner == "rr") return "rl";
+  throw InputError("model '" + model + "': unknown corner '" + corner + "' (fl, fr, rl, rr)");
+}
+
+}  // namespace dynid::model::detail

@@ -1,0 +1,61 @@
+#pragma once
+// Internal helpers shared by the model implementations.
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "dynid/model/channel_set.hpp"
+#include "dynid/model/row_model.hpp"
+
+namespace dynid::model::detail {
+
+/// Standard gravity (m/s^2), the default of the optional constant "gravity".
+inline constexpr double kStandardGravity = 9.80665;
+
+inline double sgn(double x) { return static_cast<double>((x > 0.0) - (x < 0.0)); }
+/// |x| x: a quadratic law that keeps the sign (nonlinear damping, drag at negative speed).
+inline double signed_square(double x) { return std::abs(x) * x; }
+
+/// The channel if present, else nullptr (optional channels).
+inline const Eigen::VectorXd* find(const ChannelSet& set, const std::string& name) {
+  return set.has(name) ? &set[name] : nullptr;
+}
+
+/// A column value at sample k, bound to the channels of one rows() call.
+using ValueFn = std::function<double(Eigen::Index k)>;
+
+/// An effect with one parameter whose column is value(k) in group `group` and zero elsewhere.
+RowModel::EffectDefinition one_column(Effect info, std::function<ValueFn(const ChannelSet&)> bind,
+                                      std::size_t group = 0);
+
+/// One parameter description (a-priori value optional).
+inline ParameterInfo parameter(std::string name, std::string unit, std::string description,
+                               std::optional<double> a_priori = std::nullopt) {
+  return {std::move(name), std::move(unit), std::move(description), a_priori};
+}
+
+}  // namespace dynid::model::detail
+
+namespace dynid::model::detail {
+
+/// A predicate "braking at k" (brake_pressure > threshold); always false when the channel is
+/// absent or `allowed` (brake drag modelled).
+std::function<bool(Eigen::Index)> braking(const ChannelSet& set, double threshold, bool allowed);
+
+/// The value of a channel at k (bound once).
+ValueFn channel(const ChannelSet& set, const std::string& name);
+
+/// The brake-drag effect: a force or torque k_b p proportional to brake pressure, on the
+/// resisting side; `parameter_name`, `unit` of k_b.
+RowModel::EffectDefinition brake_drag(const std::string& parameter_name, const std::string& unit);
+
+}  // namespace dynid::model::detail
+
+namespace dynid::model::detail {
+
+/// The corner on the other side of the same axle (fl <-> fr, rl <-> rr); InputError naming
+/// `model` for anything but fl, fr, rl, rr.
+std::string opposite_corner(const std::string& corner, const std::string& model);
+
+}  // namespace dynid::model::detail
