@@ -1,0 +1,72 @@
+#pragma once
+// Manoeuvres and the driver who performs them: steering, throttle, clutch, gear and brake as the
+// test driver of venture-2003 §5.3 (sine steer, step steer, spirals, lift-off) and of
+// borsotto-2008 (launches with clutch slip) would apply them, plus acceleration and coast-down.
+//
+// Contract: Driver::command() is called once per integration step, in time order; it returns the
+// inputs held over that step. The driver closes loops on what a driver sees (speed, engine
+// speed), so runs are deterministic functions of the scenario. Steering angles are road-wheel
+// angles (rad); speeds m/s; engine speeds rad/s; torques N m; pressures Pa.
+#include <string>
+
+#include "dynid/sim/car_model.hpp"
+
+namespace dynid::sim {
+
+enum class ManoeuvreType { Straight, SineSteer, StepSteer, Spiral, LiftOff, Acceleration, CoastDown, Launch };
+
+// "sine_steer" <-> ManoeuvreType::SineSteer...; parse throws InputError listing the known names.
+ManoeuvreType parse_manoeuvre_type(const std::string& name);
+std::string to_string(ManoeuvreType type);
+
+struct ManoeuvreSpec {
+  ManoeuvreType type = ManoeuvreType::Straight;
+  double speed = 20.0;      // initial speed, held by the driver in steering manoeuvres
+  int gear = 5;             // gear engaged at the start
+  double start_time = 2.0;  // when the steering input or the event begins, s
+  // Steering.
+  double amplitude = 0.02;        // sine and step: road-wheel angle, rad
+  double amplitude_end = -1.0;    // sine: amplitude at the end of the sweep (< 0: constant)
+  double frequency_start = 0.2;   // sine sweep, Hz
+  double frequency_end = 2.0;
+  double sweep_time = 20.0;       // s from start_time to frequency_end
+  double ramp_time = 0.15;        // step: rise time, s
+  double steer_rate = 0.004;      // spiral: rad/s
+  double max_steer = 0.06;        // spiral: final angle, rad (sign gives the direction)
+  // Longitudinal.
+  double drive_torque = 150.0;    // lift-off (until start_time), acceleration, N m
+  double torque_variation = 0.3;  // launch/acceleration: relative sinusoidal throttle variation
+  double shift_speed = 420.0;     // acceleration: upshift engine speed, rad/s
+  double shift_time = 0.8;        // acceleration: clutch open then re-engaging, s
+  double launch_engine_speed = 170.0;  // launch: engine speed the driver aims at, rad/s
+  double engagement_time = 1.5;   // launch: clamp load 0 -> max, s
+  double rev_limit = 450.0;       // launch: stop driving when the engine reaches this, rad/s
+  double stop_pressure = 2.0e6;   // launch: brake pressure to stop, Pa
+};
+
+class Driver {
+ public:
+  Driver(const ManoeuvreSpec& spec, const CarModel& model);
+
+  // The state the run starts from (speed, gear, clutch as the manoeuvre begins).
+  State initial_state() const;
+  DriverInputs command(double time, const State& state, double step);
+
+ private:
+  double steering(double time) const;
+  // Throttle and brake that hold `target` speed (feed-forward road load + PI).
+  void hold_speed(double target, const State& state, double step, DriverInputs& in);
+  void launch(double time, const State& state, DriverInputs& in);
+  void accelerate(double time, const State& state, DriverInputs& in);
+
+  ManoeuvreSpec spec_;
+  const CarModel& model_;
+  double speed_integral_ = 0.0;
+  // Launch and acceleration phases.
+  enum class Phase { Wait, Engage, Drive, Stop, ShiftOut, ShiftIn };
+  Phase phase_ = Phase::Wait;
+  double phase_start_ = 0.0;
+  int gear_ = 0;
+};
+
+}  // namespace dynid::sim
