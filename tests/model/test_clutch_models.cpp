@@ -1,0 +1,199 @@
+// Clutch and driveline: the slipping engine side (exact recovery; borsotto's friction case and
+// the Stribeck-speed bank) and the locked driveline per gear.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "dynid/error.hpp"
+#include "dynid/model/channel_set.hpp"
+#include "dynid/model/registry.hpp"
+#include "dynid/model/stribeck_bank.hpp"
+#include "model_test_support.hpp"
+
+namespace dynid::test {
+namespace {
+
+double sgn(double x) { return (x > 0) - (x < 0); }
+
+struct Friction {
+  double coulomb, stribeck, viscous, speed;  // mu_c, mu_s - mu_c, mu_v, v_s
+  double mu(double slip) const {
+    return coulomb * sgn(slip) + stribeck * std::exp(-(slip / speed) * (slip / speed)) * sgn(slip) +
+           viscous * slip;
+  }
+};
+
+// Borsotto §2.5 final clutch mu (chapter-3 values) with R_eq = 0.0505 m; engine inertia from
+// borsotto §1.5 (Renault Clio).
+constexpr double kRadius = 0.0505, kEngineInertia = 0.1806;
+constexpr Friction kClio{0.159, 0.168 - 0.159, 3.69e-3, 0.177};
+
+model::ChannelSet slipping_run(const Friction& f, double inertia) {
+  const Eigen::Index n = 4000;
+  const Eigen::VectorXd t = time_grid(0.01, n);
+  const Sines engine{160.0, {30.0, 5.0}, {0.5, 2.1}, {0.0, 0.3}};
+  const Sines slip{0.0, {2.0, 0.6}, {0.37, 1.9}, {0.2, 0.0}};  // crosses zero: masked there
+  const Sines load{2500.0, {800.0}, {0.8}, {0.0}};
+  const Eigen::VectorXd we = engine.values(t), dwe = engine.derivatives(t), s = slip.values(t),
+                        fn = load.values(t);
+  Eigen::VectorXd torque(n);
+  for (Eigen::Index k = 0; k < n; ++k)
+    torque(k) = inertia * dwe(k) + fn(k) * kRadius * f.mu(s(k));
+  model::ChannelSet set(0.01, n);
+  set.add("engine_speed", "rad/s", we);
+  set.add("d_engine_speed", "rad/s^2", dwe);
+  set.add("engine_torque", "N m", torque);
+  set.add("gearbox_input_speed", "rad/s", we - s);
+  set.add("clutch_clamp_load", "N", fn);
+  return set;
+}
+
+TEST(ClutchSlip, ExactRecoveryOfInertiaAndStribeckFriction) {
+  const model::ChannelSet set = slipping_run(kClio, kEngineInertia);
+  const auto m = model::make_model(
+      "clutch_slip", {{"clutch_friction_radius", kRadius}, {"stribeck_speed", kClio.speed}});
+  const Identified id = identify(*m, set, {"viscous_friction", "stribeck_friction"});
+  EXPECT_LT(relative_error(id.value("engine_inertia"), kEngineInertia), 1e-6);
+  EXPECT_LT(relative_error(id.value("coulomb_friction"), kClio.coulomb), 1e-6);
+  EXPECT_LT(relative_error(id.value("stribeck_friction"), kClio.stribeck), 1e-6);
+  EXPECT_LT(relative_error(id.value("viscous_friction"), kClio.viscous), 1e-6);
+  // Rows at slip ~ 0 are left out.
+  const auto rows = m->rows(set);
+  const Eigen::VectorXd slip = set["engine_speed"] - set["gearbox_input_speed"];
+  for (const Eigen::Index k : rows[0].samples) EXPECT_GE(std::abs(slip(k)), 1e-3);
+}
+
+// Borsotto §3.1 (L1469, Table 3.1): F_c = 6, F_s = 6.3, v_s = 0.5, sigma_v = 0.1 N m over the
+// bench speed range (|slip| up to 3.75 rad/s), static protocol (one steady point per speed).
+// Gamma_n = 1220 N x 0.0505 m (borsotto §3.6); torques are reported as mu Gamma_n.
+constexpr double kLoad = 1220.0, kGammaN = kLoad * kRadius;
+constexpr Friction kBorsotto{6.0 / kGammaN, 0.3 / kGammaN, 0.1 / kGammaN, 0.5};
+
+model::ChannelSet borsotto_static_points() {
+  const Eigen::Index n = 150;  // 75 speeds each way, 0.05 .. 3.75 rad/s
+  model::ChannelSet set(1.0, n);
+  Eigen::VectorXd slip(n), torque(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double v = 0.05 * static_cast<double>(k % 75 + 1);
+    slip(k) = k < 75 ? v : -v;
+    torque(k) = kGammaN * kBorsotto.mu(slip(k));
+  }
+  set.add("engine_speed", "rad/s", Eigen::VectorXd::Constant(n, 200.0));
+  set.add("d_engine_speed", "rad/s^2", Eigen::VectorXd::Zero(n));  // static: no inertia
+  set.add("engine_torque", "N m", torque);
+  set.add("gearbox_input_speed", "rad/s", Eigen::VectorXd::Constant(n, 200.0) - slip);
+  set.add("clutch_clamp_load", "N", Eigen::VectorXd::Constant(n, kLoad));
+  return set;
+}
+
+TEST(ClutchSlip, BorsottoFrictionCaseCoulombViscousStribeck) {
+  const model::ChannelSet set = borsotto_static_points();
+  const auto m = model::make_model("clutch_slip",
+                                   {{"clutch_friction_radius", kRadius}, {"stribeck_speed", 0.5}});
+  const Identified coulomb = identify(*m, set);
+  const Identified viscous = identify(*m, set, {"viscous_friction"});
+  const Identified stribeck = identify(*m, set, {"viscous_friction", "stribeck_friction"});
+  // Static points: the inertia column is zero, and the base-parameter analysis says so.
+  EXPECT_EQ(coulomb.status("engine_inertia"), ls::ParameterStatus::kEliminated);
+  EXPECT_TRUE(std::isnan(coulomb.value("engine_inertia")));
+
+  auto nm = [](double mu) { return mu * kGammaN; };
+  std::printf("\nBorsotto §3.1/§5 item 1 friction case (torques mu Gamma_n, N m)\n");
+  std::printf("%-22s %8s %8s %8s %8s %10s\n", "fit", "F_c", "F_s", "sigma_v", "v_s", "rel.res");
+  std::printf("%-22s %8.4f %8.4f %8.4f %8.2f %10s\n", "truth", 6.0, 6.3, 0.1, 0.5, "");
+  std::printf("%-22s %8.4f %8s %8s %8s %10.3g\n", "Coulomb", nm(coulomb.value("coulomb_friction")),
+              "-", "-", "-", coulomb.estimate.relative_residual_norm);
+  std::printf("%-22s %8.4f %8s %8.4f %8s %10.3g\n", "Coulomb + viscous",
+              nm(viscous.value("coulomb_friction")), "-", nm(viscous.value("viscous_friction")),
+              "-", viscous.estimate.relative_residual_norm);
+  const double fc = nm(stribeck.value("coulomb_friction"));
+  std::printf("%-22s %8.4f %8.4f %8.4f %8.2f %10.3g\n", "Stribeck (v_s = 0.5)", fc,
+              fc + nm(stribeck.value("stribeck_friction")), nm(stribeck.value("viscous_friction")),
+              0.5, stribeck.estimate.relative_residual_norm);
+  std::printf("(borsotto, on his unpublished grid: Coulomb 6.22, Coulomb + viscous sigma_v 0.032)\n");
+
+  // The structural bias borsotto describes: "the best constant through the points".
+  EXPECT_GT(nm(coulomb.value("coulomb_friction")), 6.1);
+  EXPECT_LT(nm(viscous.value("viscous_friction")), 0.09);
+  EXPECT_GT(relative_error(nm(viscous.value("coulomb_friction")), 6.0), 1e-3);
+  EXPECT_LT(relative_error(fc, 6.0), 1e-9);
+  EXPECT_LT(relative_error(nm(stribeck.value("stribeck_friction")), 0.3), 1e-9);
+  EXPECT_LT(relative_error(nm(stribeck.value("viscous_friction")), 0.1), 1e-9);
+}
+
+TEST(StribeckSpeedBank, PicksBorsottoStribeckSpeedAmongCandidates) {
+  const std::vector<double> candidates{0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 1.0, 1.5};
+  model::StribeckSpeedBank bank({{"clutch_friction_radius", kRadius}}, candidates);
+  const model::ChannelSet set = borsotto_static_points();
+  bank.fold(set);
+  const std::vector<double> residuals = bank.residual_norms();
+  std::printf("\nStribeck speed bank (borsotto case, v_s = 0.5)\n%8s %14s\n", "v_s", "||residual||");
+  for (std::size_t i = 0; i < bank.size(); ++i)
+    std::printf("%8.2f %14.3e\n", bank.candidate(i), residuals[i]);
+  ASSERT_EQ(bank.candidate(bank.best()), 0.5);
+  const ls::Estimate e = ls::estimate(bank.accumulator(bank.best()));
+  const auto names = bank.model(bank.best()).parameters_with(bank.effects());
+  for (std::size_t j = 0; j < names.size(); ++j)
+    if (names[j].name == "coulomb_friction") {
+      EXPECT_LT(relative_error(e.value(static_cast<Eigen::Index>(j)) * kGammaN, 6.0), 1e-9);
+    }
+  // The next-best candidate is clearly worse.
+  for (std::size_t i = 0; i < bank.size(); ++i)
+    if (i != bank.best()) {
+      EXPECT_GT(residuals[i], 1e6 * residuals[bank.best()]);
+    }
+}
+
+TEST(StribeckSpeedBank, RejectsBadCandidates) {
+  EXPECT_THROW(model::StribeckSpeedBank({{"clutch_friction_radius", kRadius}}, {}), InputError);
+  EXPECT_THROW(model::StribeckSpeedBank({{"clutch_friction_radius", kRadius}}, {0.5, -1.0}),
+               InputError);
+  EXPECT_THROW(model::StribeckSpeedBank({{"clutch_friction_radius", kRadius}}, {0.5, 0.5}),
+               InputError);
+}
+
+// Borsotto §1.5-1.6 (Renault Clio): per-gear J_bv and road load p0 + q0 v + r0 v^2 reduced to
+// the engine shaft (p = p0/alpha, q = R q0/alpha^2, r = R^2 r0/alpha^3).
+struct GearTruth {
+  int gear;
+  double alpha;
+  double inertia() const {
+    const double jv = 2 * (0.6759 + 0.152) / (alpha * alpha) + 1169.2 * 0.29 * 0.29 / (alpha * alpha);
+    return kEngineInertia + 7.67e-3 + jv;
+  }
+  double p() const { return 23.5391 / alpha; }
+  double q() const { return 0.29 * 0.1689 / (alpha * alpha); }
+  double r() const { return 0.29 * 0.29 * 0.1302 / (alpha * alpha * alpha); }
+};
+
+TEST(LockedDriveline, PerGearRecoveryOnlyFromThatGearsRows) {
+  const std::array<GearTruth, 3> gears{GearTruth{2, 8.92}, GearTruth{3, 6.07}, GearTruth{4, 4.49}};
+  const Eigen::Index n = 6000;
+  const Eigen::VectorXd t = time_grid(0.01, n);
+  const Sines speed{250.0, {80.0, 20.0}, {0.4, 1.3}, {0.0, 0.5}};
+  Eigen::VectorXd we = speed.values(t), dwe = speed.derivatives(t), torque(n), gear(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const GearTruth& g = gears[static_cast<std::size_t>(k * 3 / n)];
+    gear(k) = g.gear;
+    torque(k) = g.inertia() * dwe(k) + g.p() + g.q() * we(k) + g.r() * we(k) * we(k);
+  }
+  model::ChannelSet set(0.01, n);
+  set.add("engine_speed", "rad/s", we);
+  set.add("d_engine_speed", "rad/s^2", dwe);
+  set.add("engine_torque", "N m", torque);
+  set.add("gear", "-", gear);
+  set.add("gearbox_input_speed", "rad/s", we);
+  for (const GearTruth& g : gears) {
+    const auto m = model::make_model("locked_driveline", {{"gear", g.gear}});
+    const Identified id = identify(*m, set);
+    EXPECT_EQ(id.rows, static_cast<std::size_t>(n / 3 - (g.gear == 3 ? 2 : 1)));  // shift guard
+    EXPECT_LT(relative_error(id.value("equivalent_inertia"), g.inertia()), 1e-6) << g.gear;
+    EXPECT_LT(relative_error(id.value("road_load_constant"), g.p()), 1e-6) << g.gear;
+    EXPECT_LT(relative_error(id.value("road_load_linear"), g.q()), 1e-6) << g.gear;
+    EXPECT_LT(relative_error(id.value("road_load_quadratic"), g.r()), 1e-6) << g.gear;
+  }
+}
+
+}  // namespace
+}  // namespace dynid::test

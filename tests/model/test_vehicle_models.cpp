@@ -1,0 +1,304 @@
+// Vehicle models (longitudinal, lateral bicycle, kinematic, body 6x10): each recovers its
+// parameters to 1e-6 relative from noise-free data made with its own equations.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <map>
+
+#include "dynid/ls/equation_groups.hpp"
+#include "dynid/model/body.hpp"
+#include "dynid/model/channel_set.hpp"
+#include "dynid/model/registry.hpp"
+#include "model_test_support.hpp"
+
+namespace dynid::test {
+namespace {
+
+constexpr double kG = 9.80665;
+
+void expect_recovered(const Identified& id, const std::map<std::string, double>& truth) {
+  for (const auto& [name, value] : truth)
+    EXPECT_LT(relative_error(id.value(name), value), 1e-6)
+        << name << ": " << id.value(name) << " vs " << value;
+}
+
+// Longitudinal truth (a mid-size car: test data, not model code).
+constexpr double kMass = 1500.0, kSCx = 0.65, kRolling = 180.0, kRho = 1.2, kRadius = 0.31,
+                 kEta = 0.92;
+
+struct LongitudinalRun {
+  model::ChannelSet set;
+  Eigen::VectorXd force;  // the true drive force
+};
+
+// vx from sines with its exact derivative; the drive force from the model's own balance; a
+// braking stretch (brake_pressure > 0) where the torque is nonsense and must be masked.
+LongitudinalRun longitudinal_run(double grade_amplitude) {
+  const Eigen::Index n = 3000;
+  const Eigen::VectorXd t = time_grid(0.02, n);
+  const Sines v{22.0, {6.0, 2.0}, {0.21, 0.9}, {0.0, 0.7}};
+  const Sines grade{0.0, {grade_amplitude}, {0.13}, {0.3}};
+  LongitudinalRun run{model::ChannelSet(0.02, n), Eigen::VectorXd(n)};
+  const Eigen::VectorXd vx = v.values(t), dvx = v.derivatives(t), theta = grade.values(t);
+  Eigen::VectorXd pressure = Eigen::VectorXd::Zero(n);
+  pressure.segment(1000, 200).setConstant(3e6);
+  for (Eigen::Index k = 0; k < n; ++k)
+    run.force(k) = kMass * dvx(k) + 0.5 * kRho * kSCx * vx(k) * std::abs(vx(k)) + kRolling +
+                   kMass * kG * std::sin(theta(k));
+  run.set.add("vx", "m/s", vx);
+  run.set.add("d_vx", "m/s^2", dvx);
+  run.set.add("brake_pressure", "Pa", pressure);
+  run.set.add("road_grade", "rad", theta);
+  run.set.add("ax", "m/s^2", dvx + kG * theta.array().sin().matrix());
+  return run;
+}
+
+TEST(Longitudinal, EngineTorqueRecoversMassDragRollingAndGrade) {
+  LongitudinalRun run = longitudinal_run(0.03);
+  const Eigen::Index n = run.set.samples();
+  const Eigen::VectorXd t = time_grid(0.02, n);
+  Eigen::VectorXd ratio(n), torque(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    ratio(k) = t(k) < 20.0 ? 8.9 : (t(k) < 40.0 ? 6.1 : 4.5);
+    // Driving: F = eta T G / r; dragging: F = T G / (eta r).
+    const double f = run.force(k);
+    torque(k) = f >= 0 ? f * kRadius / (kEta * ratio(k)) : f * kRadius * kEta / ratio(k);
+  }
+  torque.segment(1000, 200).setConstant(-999.0);  // braking: not the model, must be masked
+  run.set.add("engine_torque", "N m", torque);
+  run.set.add("gear_ratio", "-", ratio);
+  const auto m = model::make_model(
+      "longitudinal_engine",
+      {{"wheel_radius", kRadius}, {"air_density", kRho}, {"driveline_efficiency", kEta}});
+  const Identified id = identify(*m, run.set, {"road_grade"});
+  EXPECT_EQ(id.rows, static_cast<std::size_t>(n - 200));
+  expect_recovered(id, {{"mass", kMass}, {"SCx", kSCx}, {"rolling_resistance", kRolling},
+                        {"grade_mass", kMass}});
+  // The accelerometer sees the same grade.
+  expect_recovered(identify(*m, run.set, {"road_grade_accelerometer"}),
+                   {{"mass", kMass}, {"grade_mass_accelerometer", kMass}});
+}
+
+TEST(Longitudinal, WheelTorqueRecoversOnFlatRoad) {
+  LongitudinalRun run = longitudinal_run(0.0);
+  run.set.add("wheel_torque", "N m", run.force * kRadius);
+  const auto m =
+      model::make_model("longitudinal_wheel", {{"wheel_radius", kRadius}, {"air_density", kRho}});
+  expect_recovered(identify(*m, run.set),
+                   {{"mass", kMass}, {"SCx", kSCx}, {"rolling_resistance", kRolling}});
+}
+
+// Lateral bicycle truth (a, b: venture §6.0 Peugeot 406 geometry; stiffnesses: test values).
+constexpr double kA = 1.09, kB = 1.60, kYaw = 2342.0, kCf = 90000.0, kCr = 110000.0,
+                 kImuX = -0.4;
+
+// Integrates the bicycle (RK4) under a steer input at varying speed; at every sample the
+// derivative is the model's right-hand side, so the equations hold exactly at the samples.
+model::ChannelSet bicycle_run() {
+  const Eigen::Index n = 4000;
+  const double dt = 0.01;
+  const Sines steer{0.0, {0.04, 0.015}, {0.9, 2.7}, {0.0, 0.4}};
+  const Sines speed{18.0, {5.0}, {0.1}, {0.0}};
+  auto rhs = [&](double t, const Eigen::Vector2d& s, double* ay) {
+    const double vx = speed.value(t), d = steer.value(t);
+    const double df = d - std::atan((s(0) + kA * s(1)) / vx);
+    const double dr = -std::atan((s(0) - kB * s(1)) / vx);
+    const double fyf = kCf * df * std::cos(d), fyr = kCr * dr;
+    if (ay != nullptr) *ay = (fyf + fyr) / kMass;
+    return Eigen::Vector2d((fyf + fyr) / kMass - s(1) * vx, (kA * fyf - kB * fyr) / kYaw);
+  };
+  model::ChannelSet set(dt, n);
+  Eigen::VectorXd vx(n), vy(n), r(n), dr(n), ay(n), st(n);
+  Eigen::Vector2d s(0.0, 0.0);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = dt * static_cast<double>(k);
+    double a = 0.0;
+    const Eigen::Vector2d f = rhs(t, s, &a);
+    vx(k) = speed.value(t), vy(k) = s(0), r(k) = s(1), dr(k) = f(1), st(k) = steer.value(t);
+    ay(k) = a + kImuX * f(1);  // the IMU sits imu_x ahead of the CG
+    const Eigen::Vector2d k1 = f, k2 = rhs(t + dt / 2, s + dt / 2 * k1, nullptr),
+                          k3 = rhs(t + dt / 2, s + dt / 2 * k2, nullptr),
+                          k4 = rhs(t + dt, s + dt * k3, nullptr);
+    s += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
+  set.add("vx", "m/s", vx);
+  set.add("vy", "m/s", vy);
+  set.add("yaw_rate", "rad/s", r);
+  set.add("d_yaw_rate", "rad/s^2", dr);
+  set.add("ay", "m/s^2", ay);
+  set.add("steer", "rad", st);
+  return set;
+}
+
+TEST(LateralBicycle, KnownMassRecoversYawInertiaAndCorneringStiffness) {
+  const model::ChannelSet set = bicycle_run();
+  const auto m =
+      model::make_model("lateral_bicycle", {{"a", kA}, {"b", kB}, {"mass", kMass}, {"imu_x", kImuX}});
+  expect_recovered(identify(*m, set), {{"yaw_inertia", kYaw},
+                                       {"front_cornering_stiffness", kCf},
+                                       {"rear_cornering_stiffness", kCr}});
+}
+
+TEST(LateralBicycle, UnknownMassRecoversPerUnitMassQuantities) {
+  const model::ChannelSet set = bicycle_run();
+  const auto m = model::make_model("lateral_bicycle", {{"a", kA}, {"b", kB}, {"imu_x", kImuX}});
+  expect_recovered(identify(*m, set), {{"yaw_inertia_per_mass", kYaw / kMass},
+                                       {"front_cornering_stiffness_per_mass", kCf / kMass},
+                                       {"rear_cornering_stiffness_per_mass", kCr / kMass}});
+}
+
+TEST(Kinematic, LongitudinalScaleOffsetAndGradeGain) {
+  const Eigen::Index n = 2000;
+  const Eigen::VectorXd t = time_grid(0.01, n);
+  const Eigen::VectorXd dvx = Sines{0.2, {1.5, 0.4}, {0.5, 2.0}, {0.0, 1.0}}.values(t);
+  const Eigen::VectorXd grade = Sines{0.01, {0.04}, {0.07}, {0.0}}.values(t);
+  model::ChannelSet set(0.01, n);
+  set.add("d_vx", "m/s^2", dvx);
+  set.add("road_grade", "rad", grade);
+  // A 2 % gain error, a 0.15 m/s^2 offset and the grade seen through the gain.
+  set.add("ax", "m/s^2",
+          1.02 * (dvx + kG * grade.array().sin().matrix()) + Eigen::VectorXd::Constant(n, 0.15));
+  const auto m = model::make_model("kinematic_longitudinal", {});
+  expect_recovered(identify(*m, set, {"road_grade"}),
+                   {{"sensor_scale", 1.02}, {"sensor_offset", 0.15}, {"grade_gain", 1.02}});
+}
+
+TEST(Kinematic, LateralScaleOffsetAndBank) {
+  const Eigen::Index n = 2000;
+  const Eigen::VectorXd t = time_grid(0.01, n);
+  const Eigen::VectorXd dvy = Sines{0.0, {0.3}, {1.1}, {0.0}}.values(t);
+  const Eigen::VectorXd vx = Sines{20.0, {3.0}, {0.2}, {0.0}}.values(t);
+  const Eigen::VectorXd r = Sines{0.0, {0.15}, {0.6}, {0.5}}.values(t);
+  const Eigen::VectorXd bank = Sines{0.0, {0.05}, {0.05}, {0.2}}.values(t);
+  model::ChannelSet set(0.01, n);
+  set.add("d_vy", "m/s^2", dvy);
+  set.add("vx", "m/s", vx);
+  set.add("yaw_rate", "rad/s", r);
+  set.add("road_bank", "rad", bank);
+  const Eigen::VectorXd kin = dvy + r.cwiseProduct(vx);
+  set.add("ay", "m/s^2",
+          0.97 * (kin + kG * bank.array().sin().matrix()) - Eigen::VectorXd::Constant(n, 0.05));
+  const auto m = model::make_model("kinematic_lateral", {});
+  expect_recovered(identify(*m, set, {"road_bank"}),
+                   {{"sensor_scale", 0.97}, {"sensor_offset", -0.05}, {"bank_gain", 0.97}});
+}
+
+// Body truth at C: venture §6.0 (Peugeot 406, inertia and first moments at the IMU point C;
+// MY and the products set to small non-zero values so that every column is tested).
+const std::map<std::string, double> kBodyTruth{
+    {"XX", 622.15}, {"XY", -13.0}, {"XZ", 44.12},     {"YY", 5898.1},  {"YZ", -7.6},
+    {"ZZ", 6198.93}, {"MX", 2421.14}, {"MY", 3.0}, {"MZ", 15.085}, {"M", 1508.5}};
+
+// Newton-Euler of a rigid body written independently of BodyModel::regressor (from the CG,
+// with Huygens), for the measured side.
+Eigen::Matrix<double, 6, 1> body_wrench(const Eigen::Vector3d& a, const Eigen::Vector3d& w,
+                                        const Eigen::Vector3d& dw) {
+  const auto& x = kBodyTruth;
+  Eigen::Matrix3d j;  // at C
+  j << x.at("XX"), x.at("XY"), x.at("XZ"), x.at("XY"), x.at("YY"), x.at("YZ"), x.at("XZ"),
+      x.at("YZ"), x.at("ZZ");
+  const Eigen::Vector3d ms(x.at("MX"), x.at("MY"), x.at("MZ"));
+  const double m = x.at("M");
+  const Eigen::Vector3d c = ms / m;  // CG from C
+  const Eigen::Vector3d a_g = a + dw.cross(c) + w.cross(w.cross(c));  // specific force at G
+  Eigen::Matrix<double, 6, 1> out;
+  out.head<3>() = m * a_g;
+  const Eigen::Matrix3d c_cross = (Eigen::Matrix3d() << 0, -c.z(), c.y(), c.z(), 0, -c.x(),
+                                   -c.y(), c.x(), 0).finished();
+  const Eigen::Matrix3d j_g = j + m * c_cross * c_cross;  // Huygens: J_C = J_G - m c~ c~
+  out.tail<3>() = j_g * dw + w.cross(j_g * w) + c.cross(out.head<3>());
+  return out;
+}
+
+TEST(Body, SixByTenRecoversMassFirstMomentsAndInertiaTensorWithGroupWeights) {
+  const Eigen::Index n = 3000;
+  const Eigen::VectorXd t = time_grid(0.01, n);
+  const std::array<Sines, 3> acc{Sines{0.0, {2.0, 0.5}, {0.4, 1.9}, {0.0, 0.3}},
+                                 Sines{0.0, {4.0, 1.0}, {0.7, 2.3}, {1.0, 0.0}},
+                                 Sines{kG, {0.8, 0.3}, {1.3, 3.1}, {0.2, 0.9}}};
+  const std::array<Sines, 3> rate{Sines{0.0, {0.08, 0.03}, {1.1, 2.9}, {0.0, 0.5}},
+                                  Sines{0.0, {0.05, 0.02}, {0.9, 3.3}, {0.7, 0.1}},
+                                  Sines{0.0, {0.3, 0.1}, {0.5, 1.7}, {0.2, 0.8}}};
+  const std::array<Eigen::Vector3d, 4> hub{Eigen::Vector3d(2.7, 0.75, 0.0),
+                                           Eigen::Vector3d(2.7, -0.75, 0.0),
+                                           Eigen::Vector3d(0.0, 0.74, 0.0),
+                                           Eigen::Vector3d(0.0, -0.74, 0.0)};
+  const std::array<const char*, 4> corner{"fl", "fr", "rl", "rr"};
+  const std::array<const char*, 6> part{"fx", "fy", "fz", "mx", "my", "mz"};
+  std::array<Eigen::VectorXd, 24> hubs;
+  for (auto& h : hubs) h.resize(n);
+  Eigen::MatrixXd motion(n, 9);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    Eigen::Vector3d a, w, dw;
+    for (int i = 0; i < 3; ++i) {
+      a(i) = acc[static_cast<std::size_t>(i)].value(t(k));
+      w(i) = rate[static_cast<std::size_t>(i)].value(t(k));
+      dw(i) = rate[static_cast<std::size_t>(i)].derivative(t(k));
+    }
+    motion.row(k) << a.transpose(), w.transpose(), dw.transpose();
+    // Three hubs carry arbitrary smooth wrenches; the fourth closes the balance at C.
+    Eigen::Matrix<double, 6, 1> rest = body_wrench(a, w, dw);
+    for (std::size_t c = 0; c < 3; ++c) {
+      Eigen::Matrix<double, 6, 1> h;
+      for (int j = 0; j < 6; ++j)
+        h(j) = (j < 3 ? 3000.0 : 50.0) * std::sin((0.3 + 0.1 * j + 0.05 * c) * t(k) + j);
+      rest.head<3>() -= h.head<3>();
+      rest.tail<3>() -= h.tail<3>() + hub[c].cross(Eigen::Vector3d(h.head<3>()));
+      for (std::size_t j = 0; j < 6; ++j) hubs[6 * c + j](k) = h(static_cast<Eigen::Index>(j));
+    }
+    const Eigen::Vector3d f4 = rest.head<3>();
+    const Eigen::Vector3d m4 = rest.tail<3>() - hub[3].cross(f4);
+    for (std::size_t j = 0; j < 3; ++j) {
+      hubs[18 + j](k) = f4(static_cast<Eigen::Index>(j));
+      hubs[21 + j](k) = m4(static_cast<Eigen::Index>(j));
+    }
+  }
+  model::ChannelSet set(0.01, n);
+  const std::array<const char*, 9> names{"ax", "ay", "az", "roll_rate", "pitch_rate",
+                                         "yaw_rate", "d_roll_rate", "d_pitch_rate", "d_yaw_rate"};
+  for (std::size_t i = 0; i < 9; ++i)
+    set.add(names[i], i < 3 ? "m/s^2" : (i < 6 ? "rad/s" : "rad/s^2"),
+            motion.col(static_cast<Eigen::Index>(i)));
+  model::Constants constants;
+  for (std::size_t c = 0; c < 4; ++c) {
+    for (std::size_t j = 0; j < 6; ++j)
+      set.add(std::string("hub_") + part[j] + "_" + corner[c], j < 3 ? "N" : "N m", hubs[6 * c + j]);
+    constants[std::string("hub_x_") + corner[c]] = hub[c].x();
+    constants[std::string("hub_y_") + corner[c]] = hub[c].y();
+    constants[std::string("hub_z_") + corner[c]] = hub[c].z();
+  }
+  const auto m = model::make_model("body", constants);
+  expect_recovered(identify(*m, set), kBodyTruth);
+
+  // DYCARO's weighted groups give the same exact answer.
+  ls::EquationGroups groups(10, m->groups());
+  const auto rows = m->rows(set);
+  for (std::size_t g = 0; g < rows.size(); ++g) groups.fold(g, rows[g].W, rows[g].y);
+  const ls::WeightedEstimate we = groups.estimate();
+  for (std::size_t j = 0; j < 10; ++j) {
+    const std::string name = m->parameters()[j].name;
+    EXPECT_LT(relative_error(we.estimate.value(static_cast<Eigen::Index>(j)), kBodyTruth.at(name)),
+              1e-6)
+        << name;
+  }
+}
+
+TEST(Body, RegressorMatchesVentureTableRowByRow) {
+  // Spot checks against the explicit table of venture §2.4 (derived there with sympy).
+  const Eigen::Vector3d a(0.3, -1.2, 9.7), w(0.11, -0.07, 0.23), dw(0.5, 0.9, -0.4);
+  const auto d = model::BodyModel::regressor(a, w, dw);
+  EXPECT_DOUBLE_EQ(d(0, 6), -(w.y() * w.y() + w.z() * w.z()));   // Fx, MX
+  EXPECT_DOUBLE_EQ(d(0, 7), w.x() * w.y() - dw.z());             // Fx, MY
+  EXPECT_DOUBLE_EQ(d(1, 8), w.y() * w.z() - dw.x());             // Fy, MZ
+  EXPECT_DOUBLE_EQ(d(3, 1), dw.y() - w.x() * w.z());             // Mx, XY
+  EXPECT_DOUBLE_EQ(d(3, 4), w.y() * w.y() - w.z() * w.z());      // Mx, YZ
+  EXPECT_DOUBLE_EQ(d(3, 8), -a.y());                             // Mx, MZ: the CG height
+  EXPECT_DOUBLE_EQ(d(4, 2), w.z() * w.z() - w.x() * w.x());      // My, XZ
+  EXPECT_DOUBLE_EQ(d(5, 1), w.x() * w.x() - w.y() * w.y());      // Mz, XY
+  EXPECT_DOUBLE_EQ(d(5, 6), a.y());                              // Mz, MX
+  EXPECT_DOUBLE_EQ(d(2, 9), a.z());                              // Fz, M
+}
+
+}  // namespace
+}  // namespace dynid::test
