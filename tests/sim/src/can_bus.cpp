@@ -109,10 +109,10 @@ const can::Signal& CanBus::signal(std::size_t binding) const {
   return *message_of_[binding]->find_signal(bindings_[binding].signal);
 }
 
-double CanBus::quantize(std::size_t binding, double si_value) const {
+double CanBus::quantize(std::size_t binding, double value) const {
   const can::Signal& s = signal(binding);
   const double to_dbc = bindings_[binding].to_dbc;
-  return can::raw_to_physical(s, can::physical_to_raw(s, si_value * to_dbc).raw) / to_dbc;
+  return can::raw_to_physical(s, can::physical_to_raw(s, value * to_dbc).raw) / to_dbc;
 }
 
 can::Frame CanBus::encode(std::size_t scheduled, const std::vector<double>& measured, double timestamp,

@@ -117,6 +117,13 @@ class Recorder {
   }
 
   void record(long step, double t, const std::vector<double>& truth, Run& run) {
+    // Before a channel's first message the receiver has its power-on reading, not a zero.
+    if (step == 0)
+      for (std::size_t c = 0; c < held_.size(); ++c) {
+        const auto b = bus_.binding_of_channel(c);
+        const double value = sensors_.measure(c, truth[c]);
+        held_[c] = b && quantize_ ? bus_.quantize(*b, value) : value;
+      }
     for (std::size_t i = 0; i < periods_.size(); ++i) {
       if (step < phases_[i] || (step - phases_[i]) % periods_[i] != 0) continue;
       sample_message(i, t, truth, run);

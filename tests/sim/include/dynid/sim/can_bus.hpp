@@ -47,7 +47,7 @@ class CanBus {
   std::size_t channel_of(std::size_t binding) const { return channel_of_[binding]; }
   std::optional<std::size_t> binding_of_channel(std::size_t channel) const;
 
-  double quantize(std::size_t binding, double si_value) const;
+  double quantize(std::size_t binding, double value) const;
   // `measured` is indexed like channel_catalogue().
   can::Frame encode(std::size_t scheduled, const std::vector<double>& measured, double timestamp,
                     const std::string& interface_name, std::uint32_t counter) const;
