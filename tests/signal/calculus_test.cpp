@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
@@ -24,7 +25,7 @@ Eigen::VectorXd times(Eigen::Index n, double period, double start) {
 
 TEST(Derivative, CentralDifferenceOfSineHasGainSinWtOverWt) {
   const double period = 0.01;
-  const double w = 2.0 * 3.14159 * 1.3;
+  const double w = 2.0 * std::numbers::pi * 1.3;
   const Eigen::VectorXd t = times(500, period, 0.2);
   const Eigen::VectorXd x = (w * t.array()).sin();
   const Eigen::VectorXd dx = derivative(x, period);

@@ -1,10 +1,9 @@
 #pragma once
 // Runs tests/signal/scipy_reference.py with Debian's interpreter (/usr/bin/python3, which has
 // python3-scipy; the pyenv python3 on PATH does not) and reads its answer.
+#include <Eigen/Core>
 #include <optional>
 #include <string>
-
-#include <Eigen/Core>
 
 namespace dynid::signal::test {
 

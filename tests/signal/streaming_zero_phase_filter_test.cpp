@@ -34,6 +34,8 @@ Eigen::MatrixXd stream(StreamingZeroPhaseFilter& filter, const Eigen::MatrixXd& 
     EXPECT_EQ(filter.samples_out(), out);
     // Output sample k is released once input sample k + delay is in.
     EXPECT_GE(out, in - filter.delay()) << "after " << in << " samples";
+    // Bounded state: never the whole signal.
+    EXPECT_LE(filter.buffered_samples(), filter.delay()) << "after " << in << " samples";
   }
   const Eigen::MatrixXd tail = filter.finish();
   EXPECT_EQ(out + tail.rows(), x.rows());
@@ -95,8 +97,7 @@ TEST(StreamingZeroPhaseFilter, LooseToleranceStillBoundsTheError) {
   for (double tolerance : {1e-3, 1e-6, 1e-8}) {
     StreamingZeroPhaseFilter filter(sos, 1, tolerance);
     const Eigen::MatrixXd x = test::test_signal(4 * filter.delay() + 100, 1, 3u);
-    const double error =
-        (stream(filter, x, {1}) - zero_phase_filter(sos, x)).cwiseAbs().maxCoeff();
+    const double error = (stream(filter, x, {1}) - zero_phase_filter(sos, x)).cwiseAbs().maxCoeff();
     EXPECT_LE(error, tolerance * x.cwiseAbs().maxCoeff()) << "tolerance " << tolerance;
     EXPECT_GT(error, 0.0);  // the check above is not vacuous: released samples are approximate
   }

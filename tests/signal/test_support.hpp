@@ -1,15 +1,14 @@
 #pragma once
 // Small independent helpers for the signal tests: the textbook Butterworth magnitude, a
 // frequency response evaluated straight from SOS coefficients, and test signals.
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
 #include <cmath>
 #include <complex>
 #include <numbers>
 #include <random>
 #include <string>
-
-#include <gtest/gtest.h>
-
-#include <Eigen/Core>
 
 #include "dynid/error.hpp"
 

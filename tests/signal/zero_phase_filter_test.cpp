@@ -57,7 +57,7 @@ struct Case {
 };
 
 TEST(ZeroPhaseFilter, MatchesScipySosfiltfilt) {
-  const Case cases[] = {{1, 10.0, 100.0, 400},  {2, 3.125, 650.0, 3000}, {3, 45.0, 100.0, 300},
+  const Case cases[] = {{1, 10.0, 100.0, 400},   {2, 3.125, 650.0, 3000}, {3, 45.0, 100.0, 300},
                         {4, 6.125, 650.0, 2000}, {5, 3.125, 650.0, 5000}, {6, 25.0, 100.0, 500},
                         {7, 100.0, 1000.0, 800}, {8, 6.125, 650.0, 4000}, {8, 40.0, 100.0, 200}};
   for (const Case& c : cases) {
@@ -66,7 +66,8 @@ TEST(ZeroPhaseFilter, MatchesScipySosfiltfilt) {
     const auto ref = test::run_scipy(c.order, c.cutoff_hz, c.rate_hz, &x, why);
     if (!ref) GTEST_SKIP() << why;
     ASSERT_TRUE(ref->error.empty()) << ref->error;
-    const Eigen::MatrixXd y = zero_phase_filter(butterworth_lowpass(c.order, c.cutoff_hz, c.rate_hz), x);
+    const Eigen::MatrixXd y =
+        zero_phase_filter(butterworth_lowpass(c.order, c.cutoff_hz, c.rate_hz), x);
     ASSERT_EQ(y.rows(), ref->filtered.rows());
     ASSERT_EQ(y.cols(), ref->filtered.cols());
     const double scale = x.cwiseAbs().maxCoeff();
@@ -106,7 +107,8 @@ TEST(ZeroPhaseFilter, RejectsNonFiniteSamplesNamingChannelAndSample) {
   const Sos sos = butterworth_lowpass(4, 10.0, 100.0);
   Eigen::MatrixXd x = test::test_signal(200, 3, 1u);
   x(123, 2) = std::numeric_limits<double>::quiet_NaN();
-  test::expect_input_error([&] { (void)zero_phase_filter(sos, x); }, "channel 2, sample 123 is NaN");
+  test::expect_input_error([&] { (void)zero_phase_filter(sos, x); },
+                           "channel 2, sample 123 is NaN");
   x(123, 2) = 0.0;
   x(7, 0) = -std::numeric_limits<double>::infinity();
   EXPECT_THROW((void)zero_phase_filter(sos, x), InputError);

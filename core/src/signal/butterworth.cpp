@@ -1,5 +1,6 @@
 #include "dynid/signal/butterworth.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -14,8 +15,7 @@ using Complex = std::complex<double>;
 
 void check_design(int order, double cutoff_hz, double sample_rate_hz) {
   if (order < 1 || order > 8)
-    throw InputError("butterworth_lowpass: order " + std::to_string(order) +
-                     " is outside 1..8");
+    throw InputError("butterworth_lowpass: order " + std::to_string(order) + " is outside 1..8");
   if (!std::isfinite(sample_rate_hz) || sample_rate_hz <= 0.0)
     throw InputError("butterworth_lowpass: sample rate " + std::to_string(sample_rate_hz) +
                      " Hz must be positive and finite");
@@ -60,16 +60,17 @@ T take(std::vector<T>& v, std::size_t i) {
 // with the zeros nearest to it. `poles` holds one pole per conjugate pair plus the real ones
 // (an even count of real ones, so a real pole always pairs with another real pole).
 std::vector<Biquad> pair_sections(std::vector<Complex> poles, std::vector<double> zeros) {
-  std::vector<Biquad> sections;
-  while (!poles.empty()) {
+  const auto real =
+      std::count_if(poles.begin(), poles.end(), [](Complex p) { return p.imag() == 0.0; });
+  std::vector<Biquad> sections(poles.size() - static_cast<std::size_t>(real) / 2);
+  for (auto section = sections.rbegin(); section != sections.rend(); ++section) {
     const Complex p1 = take(poles, worst_pole(poles, [](Complex) { return true; }));
-    const Complex p2 = p1.imag() == 0.0
-                           ? take(poles, worst_pole(poles, [](Complex p) { return p.imag() == 0.0; }))
-                           : std::conj(p1);
+    const Complex p2 =
+        p1.imag() == 0.0 ? take(poles, worst_pole(poles, [](Complex p) { return p.imag() == 0.0; }))
+                         : std::conj(p1);
     const double z1 = take_nearest_zero(zeros, p1);
     const double z2 = take_nearest_zero(zeros, p1);
-    sections.insert(sections.begin(), Biquad{1.0, -(z1 + z2), z1 * z2, -(p1 + p2).real(),
-                                             (p1 * p2).real()});
+    *section = Biquad{1.0, -(z1 + z2), z1 * z2, -(p1 + p2).real(), (p1 * p2).real()};
   }
   return sections;
 }

@@ -7,8 +7,7 @@
 namespace dynid::signal {
 
 StreamingDecimator::StreamingDecimator(Eigen::Index factor) : factor_(factor) {
-  if (factor < 1)
-    throw InputError("decimate: factor " + std::to_string(factor) + " must be >= 1");
+  if (factor < 1) throw InputError("decimate: factor " + std::to_string(factor) + " must be >= 1");
 }
 
 Eigen::MatrixXd StreamingDecimator::push(const Eigen::MatrixXd& chunk) {

@@ -10,12 +10,14 @@ namespace dynid::signal {
 namespace {
 
 bool finite(const Biquad& s) {
-  return std::isfinite(s.b0) && std::isfinite(s.b1) && std::isfinite(s.b2) &&
-         std::isfinite(s.a1) && std::isfinite(s.a2);
+  return std::isfinite(s.b0) && std::isfinite(s.b1) && std::isfinite(s.b2) && std::isfinite(s.a1) &&
+         std::isfinite(s.a2);
 }
 
 // Both roots of z^2 + a1 z + a2 strictly inside the unit circle (the stability triangle).
-bool stable(const Biquad& s) { return std::abs(s.a2) < 1.0 && std::abs(s.a1) < 1.0 + s.a2; }
+bool stable(const Biquad& s) {
+  return std::abs(s.a2) < 1.0 && std::abs(s.a1) < 1.0 + s.a2;
+}
 
 }  // namespace
 
@@ -23,7 +25,8 @@ Sos::Sos(std::vector<Biquad> sections) : sections_(std::move(sections)) {
   if (sections_.empty()) throw InputError("Sos: a filter needs at least one section");
   for (std::size_t i = 0; i < sections_.size(); ++i) {
     if (!finite(sections_[i]))
-      throw InputError("Sos: section " + std::to_string(i) + " has a coefficient that is not finite");
+      throw InputError("Sos: section " + std::to_string(i) +
+                       " has a coefficient that is not finite");
     if (!stable(sections_[i]))
       throw InputError("Sos: section " + std::to_string(i) +
                        " is not strictly stable (a pole on or outside the unit circle)");

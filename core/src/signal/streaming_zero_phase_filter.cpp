@@ -24,8 +24,8 @@ double pole_radius(const Sos& sos) {
   double radius = 0.0;
   for (const Biquad& s : sos.sections()) {
     const double disc = s.a1 * s.a1 - 4.0 * s.a2;
-    const double r = disc < 0.0 ? std::sqrt(s.a2)
-                                : 0.5 * (std::abs(s.a1) + std::sqrt(disc));  // the larger root
+    const double r =
+        disc < 0.0 ? std::sqrt(s.a2) : 0.5 * (std::abs(s.a1) + std::sqrt(disc));  // the larger root
     radius = std::max(radius, r);
   }
   return radius;
@@ -58,7 +58,10 @@ void impulse_magnitudes(const Sos& sos, Visit visit) {
 Eigen::Index zero_phase_overlap(const Sos& sos, double tolerance) {
   check_tolerance(tolerance);
   double norm1 = 0.0;
-  impulse_magnitudes(sos, [&](double a) { norm1 += a; return true; });
+  impulse_magnitudes(sos, [&](double a) {
+    norm1 += a;
+    return true;
+  });
   // Error at a released sample <= sum_{m > L} |h[m]| * max|u - u_j| with u the forward output,
   // |u| <= ||h||_1 * 3 max|x| (odd extension values reach 3 max|x|), so the variation <= 6 ...
   const double allowed_tail = tolerance / (6.0 * norm1);
@@ -69,11 +72,11 @@ Eigen::Index zero_phase_overlap(const Sos& sos, double tolerance) {
     ++count;
     return norm1 - prefix > allowed_tail;
   });
-  return count;  // h[0..count) summed: the tail beyond L = count - 1 is small enough
+  // h[0..count) summed: what is left, h[m] for m > count - 1, is small enough.
+  return std::max<Eigen::Index>(1, count - 1);
 }
 
-StreamingZeroPhaseFilter::StreamingZeroPhaseFilter(Sos sos, Eigen::Index channels,
-                                                   double tolerance)
+StreamingZeroPhaseFilter::StreamingZeroPhaseFilter(Sos sos, Eigen::Index channels, double tolerance)
     : sos_(std::move(sos)),
       unit_state_(detail::unit_steady_state(sos_)),
       channels_(channels),

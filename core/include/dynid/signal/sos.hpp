@@ -4,9 +4,8 @@
 // Why sections: a high-order filter with poles close to z = 1 (low cut-off / high sample rate,
 // the usual case here: a few Hz at hundreds of Hz) loses all its accuracy as one polynomial;
 // as a cascade of biquads each section keeps its own poles accurate.
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 namespace dynid::signal {
 

@@ -51,6 +51,9 @@ class StreamingZeroPhaseFilter {
   Eigen::Index delay() const { return overlap_ + block_ - 1; }
   Eigen::Index samples_in() const { return n_in_; }
   Eigen::Index samples_out() const { return n_out_; }
+  // Samples held between calls (raw ones before the forward pass starts, then forward outputs
+  // not yet released): at most delay() after any push().
+  Eigen::Index buffered_samples() const { return head_.rows() + pending_rows_; }
   bool finished() const { return finished_; }
 
  private:
@@ -69,10 +72,10 @@ class StreamingZeroPhaseFilter {
   Eigen::Index n_in_ = 0;
   Eigen::Index n_out_ = 0;
   bool finished_ = false;
-  Eigen::MatrixXd head_;     // raw samples until padlen + 1 are in (the forward pass waits)
-  Eigen::MatrixXd raw_tail_; // last padlen + 1 raw samples, for the odd extension at the end
+  Eigen::MatrixXd head_;           // raw samples until padlen + 1 are in (the forward pass waits)
+  Eigen::MatrixXd raw_tail_;       // last padlen + 1 raw samples, for the odd extension at the end
   Eigen::MatrixXd forward_state_;  // 2 per section x channels
-  Eigen::MatrixXd pending_;  // forward outputs of samples n_out_.. (first pending_rows_ rows)
+  Eigen::MatrixXd pending_;        // forward outputs of samples n_out_.. (first pending_rows_ rows)
   Eigen::Index pending_rows_ = 0;
 };
 

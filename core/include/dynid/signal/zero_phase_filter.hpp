@@ -20,9 +20,9 @@ namespace dynid::signal {
 // #sections with a2 == 0)).
 Eigen::Index zero_phase_padlen(const Sos& sos);
 
-// Filters each column (a channel) of x, rows = samples (a VectorXd converts to one channel). Throws InputError when x has no more
-// than zero_phase_padlen(sos) rows, or when a sample is NaN or infinite (naming the channel and
-// the sample index).
+// Filters each column (a channel) of x, rows = samples (a VectorXd converts to one channel). Throws
+// InputError when x has no more than zero_phase_padlen(sos) rows, or when a sample is NaN or
+// infinite (naming the channel and the sample index).
 Eigen::MatrixXd zero_phase_filter(const Sos& sos, const Eigen::MatrixXd& x);
 
 }  // namespace dynid::signal
