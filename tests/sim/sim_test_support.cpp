@@ -29,3 +29,16 @@ double truth_value(const Run& r, const std::string& key) {
 }
 
 }  // namespace dynid::sim::test
+
+#include <fstream>
+#include <sstream>
+
+namespace dynid::sim::test {
+std::string load_scenario_text(const std::string& file) {
+  std::ifstream in(std::string(DYNID_SCENARIO_DIR) + "/" + file);
+  if (!in) throw InputError("cannot open scenario " + file);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+}  // namespace dynid::sim::test

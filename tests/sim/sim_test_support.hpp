@@ -20,3 +20,8 @@ std::vector<double> column(const Run& run, const std::string& channel, bool trut
 double truth_value(const Run& run, const std::string& dotted_key);
 
 }  // namespace dynid::sim::test
+
+namespace dynid::sim::test {
+// The text of a committed scenario (deploy/scenarios/<file>).
+std::string load_scenario_text(const std::string& file);
+}  // namespace dynid::sim::test
