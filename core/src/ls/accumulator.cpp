@@ -24,9 +24,12 @@ static_assert(std::numeric_limits<Extended>::digits == 64,
 
 // Rows are folded in slices of at most this many, so the workspace stays bounded whatever
 // the size of the chunk handed to fold().
-constexpr Eigen::Index kSliceRows = 2048;
-// dtpqrt block size: columns per compact-WY block.
-constexpr Eigen::Index kMaxBlock = 64;
+constexpr Eigen::Index kSliceRows = 4096;
+// dtpqrt block size: columns per compact-WY block. Small on purpose: dtpqrt2 builds the block's
+// triangular factor T (extra O(m nb^2) work) that is only used on the trailing columns; with
+// nb = n+1 that is pure overhead (measured: nb=4 is 1.3x faster than nb=n+1 at n=10, 1.6x at
+// n=64; docs/BENCHMARKS.md).
+constexpr Eigen::Index kMaxBlock = 4;
 
 constexpr char kMagic[8] = {'D', 'Y', 'N', 'I', 'D', 'A', 'C', 'C'};
 constexpr std::uint32_t kFormatVersion = 1;
@@ -51,30 +54,29 @@ void require_finite(const Eigen::Ref<const Eigen::MatrixXd>& m, const char* what
 // triangular), B (m x N, column-major) the new rows, destroyed. Reflection k mixes row k of R
 // with the m rows of B only, so the work is 2 m N^2 and R never grows. When B is upper
 // triangular (a merge), column k of B is non-zero in its first k+1 rows only, and stays so.
-void householder_fold(Accumulator::ExtendedMatrix& R, Extended* B, Eigen::Index m,
-                      bool triangular) {
+// Dot products and updates go through Eigen, which vectorizes them for double.
+template <typename Scalar>
+void householder_fold(Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>& R, Scalar* B,
+                      Eigen::Index m, bool triangular) {
+  using Column = Eigen::Map<Eigen::Matrix<Scalar, Eigen::Dynamic, 1>>;
   const Eigen::Index N = R.cols();
   for (Eigen::Index k = 0; k < N; ++k) {
     const Eigen::Index rows = triangular ? std::min(m, k + 1) : m;
-    Extended* bk = B + k * m;
-    Extended tail = 0;
-    for (Eigen::Index i = 0; i < rows; ++i) tail += bk[i] * bk[i];
+    Column bk(B + k * m, rows);
+    const Scalar tail = bk.squaredNorm();
     if (tail == 0) continue;  // nothing to annihilate in this column
-    const Extended alpha = R(k, k);
+    const Scalar alpha = R(k, k);
     // No overflow: entries come from doubles, and long double's range squares them safely.
-    const Extended norm = std::sqrt(alpha * alpha + tail);
-    const Extended beta = alpha >= 0 ? -norm : norm;
-    const Extended tau = (beta - alpha) / beta;
-    const Extended to_v = 1 / (alpha - beta);  // v = [1; bk / (alpha - beta)]
-    for (Eigen::Index i = 0; i < rows; ++i) bk[i] *= to_v;
+    const Scalar norm = std::sqrt(alpha * alpha + tail);
+    const Scalar beta = alpha >= 0 ? -norm : norm;
+    const Scalar tau = (beta - alpha) / beta;
+    bk /= (alpha - beta);  // v = [1; bk / (alpha - beta)]
     R(k, k) = beta;
     for (Eigen::Index j = k + 1; j < N; ++j) {
-      Extended* bj = B + j * m;
-      Extended w = R(k, j);
-      for (Eigen::Index i = 0; i < rows; ++i) w += bk[i] * bj[i];
-      w *= tau;
+      Column bj(B + j * m, rows);
+      const Scalar w = tau * (R(k, j) + bk.dot(bj));
       R(k, j) -= w;
-      for (Eigen::Index i = 0; i < rows; ++i) bj[i] -= w * bk[i];
+      bj -= w * bk;
     }
   }
 }
@@ -178,7 +180,7 @@ void Accumulator::merge(const Accumulator& other) {
 }
 
 void Accumulator::fold_extended(Extended* rows, Eigen::Index m, bool triangular) {
-  householder_fold(r_aug_, rows, m, triangular);
+  householder_fold<Extended>(r_aug_, rows, m, triangular);
 }
 
 void Accumulator::fold_double(double* rows, Eigen::Index m, bool triangular) {
