@@ -35,13 +35,11 @@ inline constexpr const char* kNonlinearDamping = "nonlinear_damping";  ///< |v| 
 inline constexpr const char* kProgressiveStiffness = "progressive_stiffness";  ///< x^3 or x^2
 inline constexpr const char* kTyreDamping = "tyre_damping";
 inline constexpr const char* kTyreSaturation = "tyre_saturation";  ///< |alpha| alpha (Fiala)
-inline constexpr const char* kDryFriction = "dry_friction";
 inline constexpr const char* kStribeck = "stribeck_friction";
 inline constexpr const char* kViscous = "viscous_friction";
 inline constexpr const char* kTorqueOffset = "engine_torque_offset";  ///< sensor offset
 inline constexpr const char* kSteerOffset = "steer_offset";          ///< sensor offset
 inline constexpr const char* kForceOffset = "hub_force_offset";      ///< sensor offsets
-inline constexpr const char* kSensorScale = "sensor_scale";
 inline constexpr const char* kDictionaryPrefix = "dict:";
 }  // namespace effect
 
