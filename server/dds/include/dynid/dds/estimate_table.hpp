@@ -1,0 +1,55 @@
+#pragma once
+// EstimateTable: what the server publishes about one model of one vehicle (wire type Estimate)
+// and what engineers print: one row per standard parameter (value, standard deviation,
+// relative standard deviation %, status, regrouping relation) and the fit's figures.
+//
+// make_estimate_table() builds it from an ls::Estimate; `names` and `units` are the model's
+// parameter names and units, in its column order (InputError if their sizes differ from the
+// estimate's). Relations are filled for regrouped parameters (BaseParameterAnalysis::relation).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "dynid/ls/base_parameters.hpp"
+#include "dynid/ls/estimate.hpp"
+
+namespace dynid::dds {
+
+struct ParameterEntry {
+  std::string name;
+  std::string unit;
+  double value = 0.0;                 ///< NaN when not identifiable
+  double standard_deviation = 0.0;    ///< NaN when not identifiable
+  double relative_std_percent = 0.0;  ///< 100 sigma / |value|
+  ls::ParameterStatus status = ls::ParameterStatus::kIdentified;
+  std::string relation;  ///< for kRegrouped: the base-parameter combination
+};
+
+struct GroupResidual {
+  std::string group;
+  std::uint64_t rows = 0;
+  double residual_rms = 0.0;
+};
+
+struct EstimateTable {
+  std::string vehicle;
+  std::string model;
+  std::string source;          ///< run id or pool id
+  std::uint64_t revision = 0;  ///< increases with every publication for (vehicle, model)
+  std::vector<ParameterEntry> parameters;
+  std::uint64_t rows = 0;
+  double effective_rows = 0.0;
+  double sigma = 0.0;
+  double condition_number = 0.0;
+  double residual_rms = 0.0;
+  double relative_residual_norm = 0.0;
+  std::vector<GroupResidual> groups;
+};
+
+EstimateTable make_estimate_table(const std::string& vehicle, const std::string& model,
+                                  const std::string& source,
+                                  const std::vector<std::string>& names,
+                                  const std::vector<std::string>& units,
+                                  const ls::Estimate& estimate);
+
+}  // namespace dynid::dds

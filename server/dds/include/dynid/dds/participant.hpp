@@ -1,0 +1,52 @@
+#pragma once
+// Participant: a DDS domain participant on a domain created with an explicit Cyclone
+// configuration. There is no default: a participant never falls back to Cyclone's built-in
+// configuration (which picks the machine's default interface), so tests and the demo stay on
+// the interface that deploy/cyclonedds/*.xml selects.
+//
+// Contract:
+// - `config` is what Cyclone accepts in CYCLONEDDS_URI: file URIs ("file:///path.xml") and XML
+//   fragments, comma-separated, later ones overriding earlier ones. Empty -> DdsError.
+// - Cyclone allows one instance of a domain per process. The first Participant on a domain id
+//   creates it with its config; later participants in the same process share it and must pass
+//   the same config string (DdsError otherwise, rather than silently running on another
+//   config). The domain is deleted with its last Participant.
+// - Two participants of one process on one domain talk through Cyclone's local delivery, with
+//   the same QoS and partition matching as across processes.
+#include <dds/dds.h>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "dynid/dds/entity.hpp"
+
+namespace dynid::dds {
+
+struct ParticipantOptions {
+  dds_domainid_t domain_id = 0;
+  std::string config;  ///< required, see above
+};
+
+/// "file://<absolute path>" for a configuration file (throws DdsError if it does not exist).
+std::string config_file_uri(const std::filesystem::path& file);
+
+class Participant {
+ public:
+  explicit Participant(const ParticipantOptions& options);
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+  ~Participant();
+
+  dds_entity_t handle() const { return participant_.get(); }
+  dds_domainid_t domain_id() const { return domain_id_; }
+
+  class Domain;  // process-wide, shared by the participants of one domain id
+
+ private:
+  dds_domainid_t domain_id_;
+  std::shared_ptr<Domain> domain_;  // declared first: destroyed after the participant
+  Entity participant_;
+};
+
+}  // namespace dynid::dds

@@ -1,0 +1,219 @@
+// Conversions of the state and request topics: ChunkAck, Estimate, Request, Reply.
+#include <algorithm>
+#include <cstdint>
+#include <string>
+
+#include "dynid/dds/conversions.hpp"
+#include "wire_fields.hpp"
+
+namespace dynid::dds {
+
+using wire_fields::allocate;
+using wire_fields::elements;
+using wire_fields::get;
+using wire_fields::put_id;
+using wire_fields::put_text;
+
+namespace {
+
+dynid_wire_ParameterStatus to_wire_status(ls::ParameterStatus status) {
+  switch (status) {
+    case ls::ParameterStatus::kIdentified: return dynid_wire_IDENTIFIED;
+    case ls::ParameterStatus::kRegrouped: return dynid_wire_REGROUPED;
+    case ls::ParameterStatus::kDependent: return dynid_wire_DEPENDENT;
+    case ls::ParameterStatus::kEliminated: return dynid_wire_ELIMINATED;
+  }
+  throw InputError("Estimate: unknown parameter status");
+}
+
+ls::ParameterStatus from_wire_status(dynid_wire_ParameterStatus status, const std::string& where) {
+  switch (status) {
+    case dynid_wire_IDENTIFIED: return ls::ParameterStatus::kIdentified;
+    case dynid_wire_REGROUPED: return ls::ParameterStatus::kRegrouped;
+    case dynid_wire_DEPENDENT: return ls::ParameterStatus::kDependent;
+    case dynid_wire_ELIMINATED: return ls::ParameterStatus::kEliminated;
+  }
+  throw InputError(where + ": unknown status " + std::to_string(static_cast<int>(status)));
+}
+
+dynid_wire_ReplyStatus to_wire_status(ReplyStatus status) {
+  switch (status) {
+    case ReplyStatus::kOk: return dynid_wire_OK;
+    case ReplyStatus::kBadRequest: return dynid_wire_BAD_REQUEST;
+    case ReplyStatus::kNotFound: return dynid_wire_NOT_FOUND;
+    case ReplyStatus::kFailed: return dynid_wire_FAILED;
+  }
+  throw InputError("Reply: unknown status");
+}
+
+ReplyStatus from_wire_status(dynid_wire_ReplyStatus status, const std::string& where) {
+  switch (status) {
+    case dynid_wire_OK: return ReplyStatus::kOk;
+    case dynid_wire_BAD_REQUEST: return ReplyStatus::kBadRequest;
+    case dynid_wire_NOT_FOUND: return ReplyStatus::kNotFound;
+    case dynid_wire_FAILED: return ReplyStatus::kFailed;
+  }
+  throw InputError(where + ": unknown status " + std::to_string(static_cast<int>(status)));
+}
+
+void put_parameter(dynid_wire_ParameterRow& out, const ParameterEntry& entry,
+                   const std::string& where) {
+  put_id(out.name, entry.name, where + " parameter name");
+  put_id(out.unit, entry.unit, where + " parameter unit");
+  out.value = entry.value;
+  out.standard_deviation = entry.standard_deviation;
+  out.relative_std_percent = entry.relative_std_percent;
+  out.status = to_wire_status(entry.status);
+  put_text(out.relation, entry.relation);
+}
+
+ParameterEntry get_parameter(const dynid_wire_ParameterRow& in, const std::string& where) {
+  ParameterEntry entry;
+  entry.name = get(in.name, where + " parameter name");
+  const std::string at = where + " parameter '" + entry.name + "'";
+  entry.unit = get(in.unit, at + " unit");
+  entry.value = in.value;
+  entry.standard_deviation = in.standard_deviation;
+  entry.relative_std_percent = in.relative_std_percent;
+  entry.status = from_wire_status(in.status, at);
+  entry.relation = get(in.relation, at + " relation");
+  return entry;
+}
+
+}  // namespace
+
+Sample<dynid_wire_ChunkAck> to_wire(const ChunkReceipt& receipt) {
+  const std::string where = "ChunkAck " + receipt.vehicle + "/" + receipt.run;
+  Sample<dynid_wire_ChunkAck> sample;
+  put_id(sample.data.vehicle, receipt.vehicle, where + " vehicle");
+  put_id(sample.data.run, receipt.run, where + " run");
+  sample.data.highest_contiguous = receipt.highest_contiguous;
+  // The car needs the recent rejections; older ones were reported in earlier receipts.
+  const std::size_t count = std::min<std::size_t>(receipt.rejections.size(), dynid_wire_kMaxRejections);
+  const std::size_t first = receipt.rejections.size() - count;
+  auto* rejections = allocate(sample.data.rejections, count, dynid_wire_kMaxRejections, where);
+  for (std::size_t k = 0; k < count; ++k) {
+    rejections[k].sequence_number = receipt.rejections[first + k].sequence;
+    put_text(rejections[k].reason, receipt.rejections[first + k].reason);
+  }
+  return sample;
+}
+
+ChunkReceipt from_wire(const dynid_wire_ChunkAck& sample) {
+  ChunkReceipt receipt;
+  receipt.vehicle = get(sample.vehicle, "ChunkAck vehicle");
+  receipt.run = get(sample.run, "ChunkAck " + receipt.vehicle + " run");
+  const std::string where = "ChunkAck " + receipt.vehicle + "/" + receipt.run;
+  if (sample.highest_contiguous < -1)
+    throw InputError(where + ": highest contiguous sequence " +
+                     std::to_string(sample.highest_contiguous) + " (-1 is 'none')");
+  receipt.highest_contiguous = sample.highest_contiguous;
+  for (const auto& rejection :
+       elements(sample.rejections, dynid_wire_kMaxRejections, where + " rejections"))
+    receipt.rejections.push_back(
+        {rejection.sequence_number, get(rejection.reason, where + " rejection reason")});
+  return receipt;
+}
+
+Sample<dynid_wire_Estimate> to_wire(const EstimateTable& table) {
+  const std::string where = "Estimate " + table.vehicle + "/" + table.model;
+  Sample<dynid_wire_Estimate> sample;
+  auto& out = sample.data;
+  put_id(out.vehicle, table.vehicle, where + " vehicle");
+  put_id(out.model, table.model, where + " model");
+  put_id(out.source, table.source, where + " source");
+  out.revision = table.revision;
+  auto* parameters = allocate(out.parameters, table.parameters.size(), dynid_wire_kMaxParameters,
+                              where + " parameters");
+  for (std::size_t k = 0; k < table.parameters.size(); ++k)
+    put_parameter(parameters[k], table.parameters[k], where);
+  out.rows = table.rows;
+  out.effective_rows = table.effective_rows;
+  out.sigma = table.sigma;
+  out.condition_number = table.condition_number;
+  out.residual_rms = table.residual_rms;
+  out.relative_residual_norm = table.relative_residual_norm;
+  auto* groups = allocate(out.groups, table.groups.size(), dynid_wire_kMaxGroups, where + " groups");
+  for (std::size_t k = 0; k < table.groups.size(); ++k) {
+    put_id(groups[k].group, table.groups[k].group, where + " group name");
+    groups[k].rows = table.groups[k].rows;
+    groups[k].residual_rms = table.groups[k].residual_rms;
+  }
+  return sample;
+}
+
+EstimateTable from_wire(const dynid_wire_Estimate& sample) {
+  EstimateTable table;
+  table.vehicle = get(sample.vehicle, "Estimate vehicle");
+  table.model = get(sample.model, "Estimate " + table.vehicle + " model");
+  const std::string where = "Estimate " + table.vehicle + "/" + table.model;
+  table.source = get(sample.source, where + " source");
+  table.revision = sample.revision;
+  for (const auto& row : elements(sample.parameters, dynid_wire_kMaxParameters, where + " parameters"))
+    table.parameters.push_back(get_parameter(row, where));
+  table.rows = sample.rows;
+  table.effective_rows = sample.effective_rows;
+  table.sigma = sample.sigma;
+  table.condition_number = sample.condition_number;
+  table.residual_rms = sample.residual_rms;
+  table.relative_residual_norm = sample.relative_residual_norm;
+  for (const auto& group : elements(sample.groups, dynid_wire_kMaxGroups, where + " groups"))
+    table.groups.push_back({get(group.group, where + " group name"), group.rows, group.residual_rms});
+  return table;
+}
+
+Sample<dynid_wire_Request> to_wire(const Request& request) {
+  const std::string where = "Request " + request.client + "#" + std::to_string(request.correlation_id);
+  Sample<dynid_wire_Request> sample;
+  put_id(sample.data.client, request.client, where + " client");
+  sample.data.correlation_id = request.correlation_id;
+  put_id(sample.data.kind, request.kind, where + " kind");
+  auto* arguments = allocate(sample.data.arguments, request.arguments.size(),
+                             dynid_wire_kMaxArguments, where + " arguments");
+  for (std::size_t k = 0; k < request.arguments.size(); ++k) {
+    put_id(arguments[k].name, request.arguments[k].name, where + " argument name");
+    put_id(arguments[k].value, request.arguments[k].value, where + " argument value");
+  }
+  return sample;
+}
+
+Request from_wire(const dynid_wire_Request& sample) {
+  Request request;
+  request.client = get(sample.client, "Request client");
+  request.correlation_id = sample.correlation_id;
+  const std::string where = "Request " + request.client + "#" + std::to_string(request.correlation_id);
+  request.kind = get(sample.kind, where + " kind");
+  for (const auto& argument : elements(sample.arguments, dynid_wire_kMaxArguments, where + " arguments"))
+    request.arguments.push_back(
+        {get(argument.name, where + " argument name"), get(argument.value, where + " argument value")});
+  return request;
+}
+
+Sample<dynid_wire_Reply> to_wire(const Reply& reply) {
+  const std::string where = "Reply " + reply.client + "#" + std::to_string(reply.correlation_id);
+  Sample<dynid_wire_Reply> sample;
+  put_id(sample.data.client, reply.client, where + " client");
+  sample.data.correlation_id = reply.correlation_id;
+  sample.data.status = to_wire_status(reply.status);
+  put_text(sample.data.error, reply.error);
+  put_id(sample.data.payload_format, reply.payload_format, where + " payload format");
+  auto* payload = allocate(sample.data.payload, reply.payload.size(), dynid_wire_kMaxPayload,
+                           where + " payload bytes");
+  if (payload != nullptr) std::copy(reply.payload.begin(), reply.payload.end(), payload);
+  return sample;
+}
+
+Reply from_wire(const dynid_wire_Reply& sample) {
+  Reply reply;
+  reply.client = get(sample.client, "Reply client");
+  reply.correlation_id = sample.correlation_id;
+  const std::string where = "Reply " + reply.client + "#" + std::to_string(reply.correlation_id);
+  reply.status = from_wire_status(sample.status, where);
+  reply.error = get(sample.error, where + " error");
+  reply.payload_format = get(sample.payload_format, where + " payload format");
+  const auto payload = elements(sample.payload, dynid_wire_kMaxPayload, where + " payload");
+  reply.payload.assign(payload.begin(), payload.end());
+  return reply;
+}
+
+}  // namespace dynid::dds

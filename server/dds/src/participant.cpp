@@ -1,0 +1,66 @@
+#include "dynid/dds/participant.hpp"
+
+#include <map>
+#include <mutex>
+
+#include "dynid/dds/error.hpp"
+
+namespace dynid::dds {
+
+// One Cyclone domain instance, created with an explicit configuration. Shared by the
+// Participants of its domain id in this process; deleted with the last of them.
+class Participant::Domain {
+ public:
+  Domain(dds_domainid_t id, std::string config) : config_(std::move(config)) {
+    handle_ = Entity(check(dds_create_domain(id, config_.c_str()),
+                           "dds_create_domain(" + std::to_string(id) + ")"));
+  }
+  const std::string& config() const { return config_; }
+
+ private:
+  std::string config_;
+  Entity handle_;
+};
+
+namespace {
+
+// Cyclone keeps one instance per domain id and process, so the registry is process-wide.
+std::shared_ptr<Participant::Domain> acquire_domain(dds_domainid_t id, const std::string& config) {
+  static std::mutex mutex;
+  static std::map<dds_domainid_t, std::weak_ptr<Participant::Domain>> domains;
+  const std::lock_guard lock(mutex);
+  if (auto existing = domains[id].lock()) {
+    if (existing->config() != config)
+      throw DdsError("Participant: domain " + std::to_string(id) +
+                         " already runs in this process with another configuration",
+                     DDS_RETCODE_PRECONDITION_NOT_MET);
+    return existing;
+  }
+  auto created = std::make_shared<Participant::Domain>(id, config);
+  domains[id] = created;
+  return created;
+}
+
+}  // namespace
+
+std::string config_file_uri(const std::filesystem::path& file) {
+  std::error_code error;
+  const auto absolute = std::filesystem::canonical(file, error);
+  if (error)
+    throw DdsError("config_file_uri: no configuration file " + file.string(),
+                   DDS_RETCODE_BAD_PARAMETER);
+  return "file://" + absolute.string();
+}
+
+Participant::Participant(const ParticipantOptions& options) : domain_id_(options.domain_id) {
+  if (options.config.empty())
+    throw DdsError("Participant: no Cyclone configuration given (the default one is never used)",
+                   DDS_RETCODE_BAD_PARAMETER);
+  domain_ = acquire_domain(options.domain_id, options.config);
+  participant_ = Entity(check(dds_create_participant(options.domain_id, nullptr, nullptr),
+                              "dds_create_participant"));
+}
+
+Participant::~Participant() = default;
+
+}  // namespace dynid::dds

@@ -1,0 +1,55 @@
+#include "dynid/dds/qos.hpp"
+
+namespace dynid::dds {
+
+namespace {
+
+dds_duration_t to_duration(std::chrono::milliseconds value) { return DDS_MSECS(value.count()); }
+
+}  // namespace
+
+Qos::Qos(const Qos& other) : qos_(dds_create_qos()) { dds_copy_qos(qos_, other.qos_); }
+
+Qos& Qos::operator=(const Qos& other) {
+  if (this != &other) dds_copy_qos(qos_, other.qos_);
+  return *this;
+}
+
+Qos& Qos::partitions(const std::vector<std::string>& names) {
+  std::vector<const char*> pointers;
+  for (const auto& name : names) pointers.push_back(name.c_str());
+  dds_qset_partition(qos_, static_cast<uint32_t>(pointers.size()), pointers.data());
+  return *this;
+}
+
+namespace {
+
+// Reliable, volatile, keep-all bounded by `limits`: a full reader makes the writer block up to
+// max_blocking_time, then report a timeout, instead of dropping or growing without bound.
+Qos reliable_keep_all(const KeepAllLimits& limits) {
+  Qos qos;
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, to_duration(limits.max_blocking_time));
+  dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_ALL, 0);
+  dds_qset_resource_limits(qos.get(), limits.max_samples, limits.max_instances,
+                           limits.max_samples_per_instance);
+  return qos;
+}
+
+}  // namespace
+
+Qos chunk_qos(const KeepAllLimits& limits) { return reliable_keep_all(limits); }
+
+Qos state_qos() {
+  Qos qos;
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_durability(qos.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 1);
+  // A writer that goes away (server restart) leaves its last states alive in readers.
+  dds_qset_writer_data_lifecycle(qos.get(), false);
+  return qos;
+}
+
+Qos request_qos(const KeepAllLimits& limits) { return reliable_keep_all(limits); }
+
+}  // namespace dynid::dds
