@@ -1,0 +1,243 @@
+#!/usr/bin/env bash
+# Real-kernel test of the live SocketCAN path (see shared/notes/socketcan-vm.md): the build
+# machines' kernel has no CAN, so this boots Debian's own kernel under qemu (TCG, no network),
+# plays a candump log onto a vcan interface with canplayer, adds an extended-id, a remote and
+# CAN FD frames with cansend, and checks that dynid-socketcan-dump received exactly those frames
+# (ids, flags, payloads) with sane kernel timestamps (non-decreasing, wall-clock, paced like the
+# log).
+#
+#   socketcan_vm_test.sh --dump BIN --tool BIN --work DIR --cache DIR [--shared-data DIR]
+#
+# It installs what it needs (qemu-system-x86 busybox-static cpio can-utils iproute2) and
+# downloads the kernel package the linux-image-amd64 metapackage currently depends on (exact
+# name, cached in --cache). Anything it cannot get is a failure with the reason, never a skip.
+# Bounded: qemu runs under `timeout`, the whole test in about a minute.
+set -euo pipefail
+
+fail() { echo "socketcan_vm_test: FAIL: $*" >&2; exit 1; }
+say() { echo "socketcan_vm_test: $*"; }
+
+dump_bin="" tool_bin="" work="" cache="" shared=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --dump) dump_bin=$2; shift 2 ;;
+    --tool) tool_bin=$2; shift 2 ;;
+    --work) work=$2; shift 2 ;;
+    --cache) cache=$2; shift 2 ;;
+    --shared-data) shared=$2; shift 2 ;;
+    *) fail "unknown argument $1" ;;
+  esac
+done
+[ -x "$dump_bin" ] && [ -x "$tool_bin" ] && [ -n "$work" ] && [ -n "$cache" ] ||
+  fail "usage: --dump BIN --tool BIN --work DIR --cache DIR [--shared-data DIR]"
+
+readonly PACKAGES="qemu-system-x86 busybox-static cpio can-utils iproute2"
+readonly QEMU_SECONDS=90      # boot ~4 s under TCG, the log a few seconds: 90 s is a hang
+readonly LOG_SECONDS=3        # of the real log (or of a generated one)
+readonly PLAYED_IFACE=can0
+
+as_root() {
+  if [ "$(id -u)" -eq 0 ]; then "$@"
+  elif command -v sudo >/dev/null && sudo -n true 2>/dev/null; then sudo -n "$@"
+  else return 1; fi
+}
+
+install_tools() {
+  local missing=()
+  for p in $PACKAGES; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  say "installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  as_root apt-get install -y -qq --no-install-recommends "${missing[@]}" >"$work/apt.log" 2>&1 ||
+    { as_root apt-get update -qq >>"$work/apt.log" 2>&1 &&
+      as_root apt-get install -y -qq --no-install-recommends "${missing[@]}" >>"$work/apt.log" 2>&1; } ||
+    { tail -5 "$work/apt.log" >&2; fail "cannot install ${missing[*]} (needs root and Debian's package archive; log $work/apt.log)"; }
+}
+
+# The exact kernel package the metapackage points at today (no wildcard: that would fetch every
+# flavour). Falls back to a kernel already in the cache when the archive cannot be asked.
+kernel_package() {
+  local name
+  name=$(apt-cache depends linux-image-amd64 2>/dev/null | awk '/Depends: linux-image-[0-9]/{print $2; exit}')
+  if [ -z "$name" ]; then
+    as_root apt-get update -qq >/dev/null 2>&1 || true
+    name=$(apt-cache depends linux-image-amd64 2>/dev/null | awk '/Depends: linux-image-[0-9]/{print $2; exit}')
+  fi
+  if [ -z "$name" ]; then
+    local cached
+    cached=$(ls "$cache"/linux-image-*_amd64.deb 2>/dev/null | sort -V | tail -1)
+    [ -n "$cached" ] && name=$(basename "$cached" | cut -d_ -f1)
+  fi
+  [ -n "$name" ] || fail "apt-cache knows no linux-image-amd64 kernel and none is cached in $cache"
+  echo "$name"
+}
+
+# Downloads (once) and extracts the kernel package; sets kernel_root.
+get_kernel() {
+  local name deb
+  name=$(kernel_package)
+  deb=$(ls "$cache/${name}"_*_amd64.deb 2>/dev/null | sort -V | tail -1 || true)
+  if [ -z "$deb" ]; then
+    say "downloading $name"
+    (cd "$cache" && apt-get download "$name" >"$cache/download.log" 2>&1) ||
+      { tail -3 "$cache/download.log" >&2; fail "cannot download $name"; }
+    deb=$(ls "$cache/${name}"_*_amd64.deb | sort -V | tail -1)
+  fi
+  kernel_root="$cache/${name}.root"
+  if [ ! -f "$kernel_root/.extracted" ]; then
+    rm -rf "$kernel_root"
+    dpkg -x "$deb" "$kernel_root" || fail "cannot extract $deb"
+    touch "$kernel_root/.extracted"
+  fi
+  say "kernel $(basename "$deb")"
+}
+
+# Copies a program and every library ldd lists for it (with the dynamic loader) into the image.
+copy_program() {
+  local bin=$1 dest=$2
+  mkdir -p "$root$(dirname "$dest")"
+  cp -L "$bin" "$root$dest"
+  ldd "$bin" | grep -o '/[^ ]*' | while read -r lib; do
+    [ -e "$root$lib" ] || { mkdir -p "$root$(dirname "$lib")"; cp -L "$lib" "$root$lib"; }
+  done
+}
+
+# Adds a module after the modules it depends on (its modinfo "depends=", read from the .ko since
+# the package ships no modules.dep): can before can-raw; vcan needs can-dev in Debian's 6.1.
+add_module() {
+  local name=$1 file dep
+  for m in "${modules[@]}"; do [ "$m" = "$name" ] && return 0; done
+  file=$(find "$kernel_root"/lib/modules/*/kernel \( -name "$name.ko" -o -name "${name//_/-}.ko" \) | head -1)
+  [ -n "$file" ] || fail "the kernel package has no module $name.ko"
+  for dep in $(strings "$file" | sed -n 's/^depends=//p' | tr ',' ' '); do add_module "$dep"; done
+  cp "$file" "$root/lib/modules/"
+  modules+=("$name")
+}
+
+# The input log: the real RAV4 log's first seconds of can0 when present, else a generated one.
+make_input_log() {
+  local real="$shared/rav4-comma2k19/rav4_2018-08-02_seg40.candump.log"
+  if [ -n "$shared" ] && [ -f "$real" ]; then
+    say "input: first $LOG_SECONDS s of $PLAYED_IFACE in $(basename "$real")"
+    played=$("$tool_bin" excerpt "$real" "$work/input.log" "$LOG_SECONDS" "$PLAYED_IFACE")
+  else
+    say "input: generated log ($real not found)"
+    played=$("$tool_bin" generate "$work/input.log" "$LOG_SECONDS")
+  fi
+}
+
+# Frames cansend adds after the log, and how they read in candump -l form (timestamps unused).
+readonly -a EXTRA_SEND=(
+  "1F334455#DEADBEEF"
+  "321#R"
+  "7FF#"
+  "123##100112233445566778899AABB"
+  "18DAF110##3$(printf '%02X' $(seq 0 63) | tr -d '\n')"
+)
+
+# An error frame (controller problem: RX warning), which cansend sends for an 8-digit id with
+# CAN_ERR_FLAG set. The source must count it and never return it.
+readonly ERROR_SEND="20000004#0004000000000000"
+
+make_expected_log() {
+  cp "$work/input.log" "$work/expected.log"
+  for f in "${EXTRA_SEND[@]}"; do echo "(0.000000) $PLAYED_IFACE $f" >>"$work/expected.log"; done
+  expected=$((played + ${#EXTRA_SEND[@]}))
+}
+
+write_init() {
+  cat >"$root/init" <<INIT
+#!/bin/busybox sh
+/bin/busybox --install -s /bin
+export PATH=/bin:/opt/bin LD_LIBRARY_PATH=/lib/x86_64-linux-gnu:/usr/lib/x86_64-linux-gnu
+vmfail() { echo "DYNID-VM-FAIL \$*"; poweroff -f; }
+mount -t proc proc /proc && mount -t sysfs sysfs /sys && mount -t devtmpfs devtmpfs /dev ||
+  vmfail "mount"
+# Dependencies first (add_module's order): a module needs the symbols of the ones before it.
+for m in ${modules[*]}; do insmod /lib/modules/\$m.ko || vmfail "insmod \$m"; done
+/opt/bin/ip link add dev vcan0 type vcan && /opt/bin/ip link set vcan0 mtu 72 &&
+  /opt/bin/ip link set up vcan0 || vmfail "vcan0"
+/opt/bin/dynid-socketcan-dump --frames $expected --seconds 60 --output /tmp/dump.log vcan0 \
+  2>/tmp/dump.err &
+dump=\$!
+n=0
+until grep -q "reading vcan0" /tmp/dump.err 2>/dev/null; do
+  n=\$((n + 1)); [ \$n -gt 100 ] && { cat /tmp/dump.err; vmfail "dump did not start"; }
+  sleep 0.1
+done
+/opt/bin/canplayer -I /test/input.log vcan0=$PLAYED_IFACE || vmfail "canplayer"
+/opt/bin/cansend vcan0 $ERROR_SEND || vmfail "cansend $ERROR_SEND"
+for f in ${EXTRA_SEND[*]}; do /opt/bin/cansend vcan0 "\$f" || vmfail "cansend \$f"; done
+wait \$dump
+echo "DYNID-DUMP-STATUS \$?"
+cat /tmp/dump.err
+echo "DYNID-DUMP-BEGIN"
+cat /tmp/dump.log
+echo "DYNID-DUMP-END"
+poweroff -f
+INIT
+  chmod +x "$root/init"
+}
+
+build_initramfs() {
+  root="$work/root"
+  rm -rf "$root"
+  mkdir -p "$root"/{bin,dev,proc,sys,tmp,test,opt/bin,lib/modules}
+  cp /bin/busybox "$root/bin/busybox"
+  ! ldd /bin/busybox >/dev/null 2>&1 || fail "/bin/busybox is not static (busybox-static)"
+  modules=()
+  add_module can-raw
+  add_module vcan
+  say "modules, in load order: ${modules[*]}"
+  copy_program "$(command -v ip || echo /sbin/ip)" /opt/bin/ip
+  copy_program "$(command -v canplayer)" /opt/bin/canplayer
+  copy_program "$(command -v cansend)" /opt/bin/cansend
+  copy_program "$dump_bin" /opt/bin/dynid-socketcan-dump
+  cp "$work/input.log" "$root/test/input.log"
+  write_init
+  (cd "$root" && find . | cpio -o -H newc --quiet | gzip -1) >"$work/initrd.gz"
+}
+
+run_vm() {
+  local kernel
+  kernel=$(ls "$kernel_root"/boot/vmlinuz-* | head -1)
+  say "booting $(basename "$kernel") under qemu (TCG, -nic none, at most $QEMU_SECONDS s)"
+  local start=$SECONDS rc=0
+  timeout "$QEMU_SECONDS" qemu-system-x86_64 -m 512 -nographic -no-reboot -nic none \
+    -kernel "$kernel" -initrd "$work/initrd.gz" -append "console=ttyS0 quiet panic=-1" \
+    </dev/null >"$work/serial.log" 2>&1 || rc=$?
+  # Without the carriage returns and the terminal escapes the firmware writes.
+  tr -d '\r' <"$work/serial.log" | sed -e 's/\x1b\[[0-9;?]*[A-Za-z]//g' -e 's/\x1bc//g' \
+    >"$work/serial.txt"
+  say "qemu exited with $rc after $((SECONDS - start)) s (serial log $work/serial.txt)"
+  [ "$rc" -ne 124 ] || { tail -20 "$work/serial.txt" >&2; fail "the VM did not finish in $QEMU_SECONDS s"; }
+  if grep -q "DYNID-VM-FAIL" "$work/serial.txt"; then
+    tail -20 "$work/serial.txt" >&2
+    fail "inside the VM: $(grep -m1 DYNID-VM-FAIL "$work/serial.txt")"
+  fi
+  grep -q "DYNID-DUMP-END" "$work/serial.txt" ||
+    { tail -30 "$work/serial.txt" >&2; fail "no dump on the serial console"; }
+  sed -n '/^DYNID-DUMP-BEGIN$/,/^DYNID-DUMP-END$/p' "$work/serial.txt" | sed '1d;$d' >"$work/dump.log"
+  grep -E "^(DYNID-DUMP-STATUS|dynid-socketcan-dump:)" "$work/serial.txt"
+  grep -q "^DYNID-DUMP-STATUS 0$" "$work/serial.txt" || fail "dynid-socketcan-dump failed in the VM"
+  grep -q "^dynid-socketcan-dump: $expected frames, 1 error frames, 0 dropped" "$work/serial.txt" ||
+    fail "dynid-socketcan-dump did not count $expected frames, 1 error frame and no drops"
+}
+
+[ "$(uname -m)" = x86_64 ] || fail "needs an x86_64 host (qemu-system-x86_64 without KVM)"
+mkdir -p "$work" "$cache"
+install_tools
+command -v qemu-system-x86_64 >/dev/null || fail "qemu-system-x86_64 missing after install"
+get_kernel
+make_input_log
+make_expected_log
+build_initramfs
+say "initramfs $(du -h "$work/initrd.gz" | cut -f1), $played log frames + ${#EXTRA_SEND[@]} sent"
+run_vm
+# Paced frames: the log's (canplayer keeps its gaps); 0.5 s absorbs TCG scheduling. The first
+# timestamp is the guest's wall clock, which qemu's RTC sets from this machine's.
+"$tool_bin" compare "$work/expected.log" "$work/dump.log" "$played" 0.5 600 ||
+  fail "the frames received in the VM differ from the frames sent (see above; $work/dump.log)"
+say "PASS"
