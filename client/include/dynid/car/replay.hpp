@@ -1,0 +1,47 @@
+#pragma once
+// Replay: drive a CarPipeline from a FrameSource (normally a candump log), as fast as possible
+// or paced on the log's own clock, reporting progress.
+//
+// Contract:
+// - speed <= 0: as fast as possible. speed > 0: frame i is fed no earlier than
+//   start + (t_i - t_0) / speed on the steady clock (1 = real time), so 1 s of log takes ~1 s.
+// - max_log_seconds stops after that much log time (from the first frame); the pipeline is
+//   finished either way (final partial chunk emitted).
+// - on_progress is called about every progress_interval of wall time and once at the end (with
+//   done = true). Bad lines, unknown ids, short frames and other buses are counted, never sent.
+// - Exceptions from the sink (e.g. the spool is full) propagate: the replay stops there, and the
+//   chunks already handed over stay where the sink put them.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <optional>
+
+#include "dynid/car/frame_source.hpp"
+#include "dynid/car/pipeline.hpp"
+
+namespace dynid::car {
+
+struct ReplayProgress {
+  std::uint64_t frames = 0;           ///< good frames read from the source
+  std::uint64_t decoded = 0;          ///< frames the DBC decoded (mapped or not)
+  std::uint64_t unknown_id = 0;
+  std::uint64_t bad = 0;              ///< bad lines + short payloads + remote frames + NaN values
+  std::uint64_t other_interface = 0;  ///< frames of buses the profile ignores
+  std::uint64_t rows = 0;
+  std::uint64_t invalid_rows = 0;
+  std::uint64_t chunks = 0;
+  double fraction = 0.0;      ///< of the file, [0, 1]; negative for a live source
+  double log_seconds = 0.0;   ///< log time replayed
+  bool done = false;
+};
+
+struct ReplayOptions {
+  double speed = 0.0;
+  std::optional<double> max_log_seconds;
+  std::chrono::milliseconds progress_interval{1000};
+  std::function<void(const ReplayProgress&)> on_progress;
+};
+
+ReplayProgress replay(FrameSource& source, CarPipeline& pipeline, const ReplayOptions& options = {});
+
+}  // namespace dynid::car

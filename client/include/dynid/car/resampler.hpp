@@ -1,0 +1,108 @@
+#pragma once
+// Resampler: timestamped channel samples (irregular, per channel, as CAN delivers them) -> rows
+// of a uniform grid t_k = origin + k / rate, streaming.
+//
+// Interpolation rule: the value of channel c at t_k is the linear interpolation between the two
+// samples a, b of c with t_a <= t_k <= t_b (the sample itself when t_a == t_k), provided that
+// t_b - t_a <= G_c. Otherwise the channel is missing at t_k: nothing is ever interpolated across
+// a gap, and nothing is extrapolated past the last sample or before the first. A row is valid
+// when every channel has a value; an invalid row carries zeros (ingest::Chunk's convention).
+//   G_c = the mapping's max_gap if the profile sets one, else max_gap_periods x the signal's own
+//   period, estimated as the median of its last intervals (kPeriodWindow) including the one
+//   being judged. A median ignores the gap it judges (among >= kMinIntervals normal ones) and
+//   follows a real change of rate; it needs kMinIntervals intervals, so a channel's first
+//   intervals are not interpolated. The estimate is fixed when b arrives, so the result depends
+//   only on the samples, not on how they were batched. Event-driven (send-on-change) signals do
+//   not fit this rule: give them max_gap.
+//
+// Streaming and latency: the clock is the newest timestamp seen (push or advance_clock, which
+// the pipeline calls for every frame, mapped or not). Row k is emitted, in order, as soon as
+// every channel has decided it: it has a sample at or after t_k, or it is stale for t_k
+// (the clock is past its last sample + G_c, so no future sample can bracket t_k within G_c), or
+// the clock is past t_k + max_latency. So a row is emitted at most max_latency (source clock)
+// after its time even if a channel falls silent. finish() emits the rows up to the last time
+// every channel with data has reached, then stops.
+//
+// Samples of a channel that do not advance its time (duplicate or backwards timestamps) are
+// dropped and counted. Memory per channel is bounded by the samples within the latency window.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <optional>
+#include <span>
+#include <vector>
+
+namespace dynid::car {
+
+struct ResamplerConfig {
+  double rate_hz = 0.0;
+  std::size_t channels = 0;
+  double max_gap_periods = 2.5;
+  std::vector<std::optional<double>> max_gap;  ///< per channel (seconds), or empty
+  double max_latency = 1.0;                    ///< seconds of source clock
+  std::optional<double> origin;                ///< grid time 0; unset: the first sample's time
+};
+
+struct ResamplerStats {
+  std::uint64_t samples = 0;
+  std::uint64_t out_of_order = 0;  ///< dropped: time not after the channel's previous sample
+  std::uint64_t rows = 0;
+  std::uint64_t invalid_rows = 0;
+  std::vector<std::uint64_t> missing_by_channel;  ///< rows where this channel had no value
+};
+
+class Resampler {
+ public:
+  static constexpr std::size_t kPeriodWindow = 15;
+  static constexpr std::size_t kMinIntervals = 3;
+
+  /// Receives every row in grid order: index k, one value per channel, valid flag.
+  using RowSink = std::function<void(std::uint64_t, std::span<const double>, bool)>;
+
+  /// Throws InputError for a non-positive rate, no channel, max_gap_periods < 1, a
+  /// non-positive max_gap or max_latency, or a max_gap list of the wrong length.
+  Resampler(ResamplerConfig config, RowSink sink);
+
+  void push(std::size_t channel, double time, double value);
+  void advance_clock(double time);
+  void finish();
+
+  double origin() const { return origin_.value_or(0.0); }
+  bool started() const { return origin_.has_value(); }
+  std::uint64_t next_row() const { return next_row_; }
+  const ResamplerStats& stats() const { return stats_; }
+
+ private:
+  struct Sample {
+    double time;
+    double value;
+    bool bridgeable;  // the interval ending here is short enough to interpolate across
+  };
+  struct Channel {
+    std::deque<Sample> samples;
+    std::array<double, kPeriodWindow> intervals{};
+    std::size_t interval_count = 0;
+  };
+
+  double row_time(std::uint64_t k) const;
+  double judge_interval(std::size_t channel, Channel& c, double interval);
+  double stale_after(std::size_t channel, const Channel& c) const;
+  bool decided(std::size_t channel, double t) const;
+  std::optional<double> value_at(const Channel& c, double t) const;
+  void emit_ready();
+  void emit_row(double t);
+  static void prune(Channel& c, double t);
+
+  ResamplerConfig config_;
+  RowSink sink_;
+  std::vector<Channel> channels_;
+  std::optional<double> origin_;
+  double clock_ = 0.0;
+  std::uint64_t next_row_ = 0;
+  std::vector<double> row_;
+  ResamplerStats stats_;
+};
+
+}  // namespace dynid::car

@@ -1,0 +1,87 @@
+#pragma once
+// Spool: the car's on-disk queue of chunks the server has not acknowledged yet. A chunk is
+// stored before it is sent and deleted only when the server acknowledges it durably, so a lost
+// link or a restart of the car loses nothing.
+//
+// Storage: one SQLite database (spool.db in the spool directory), WAL journal with
+// synchronous=FULL, one row per chunk (vehicle, run, sequence, ingest::encode_chunk bytes,
+// time stored). Chosen over an append-only file because acknowledgements delete from the
+// front of many runs at once and a restart must find the unacknowledged chunks in order: SQLite
+// gives atomic, fsynced inserts and deletes and ordered reads for free, and a torn write at power
+// loss rolls back instead of leaving a half chunk to parse. The chunk bytes carry their own
+// CRC, checked again when read back.
+//
+// Contract:
+// - store() returns once the chunk is durable (committed, fsynced). Storing the same (vehicle,
+//   run, sequence) again with identical bytes is a no-op (a resend); with other bytes, or a
+//   sequence at or below the run's acknowledged one, it throws InputError.
+// - Bound: payload bytes (the sum of stored encodings) never exceed max_bytes. A chunk that would
+//   exceed it is not stored and SpoolFull is thrown: "spool full: N bytes of M, server
+//   unreachable since <UTC time of the oldest unacknowledged chunk> (<count> chunks
+//   unacknowledged)". Nothing is ever dropped to make room.
+// - acknowledge(vehicle, run, s): the server holds every chunk of the run up to s durably;
+//   deletes them (durably) and remembers s. Acks at or below an earlier one change nothing.
+// - pending() lists the unacknowledged chunks in the order they were stored, which is sequence
+//   order within a run, also after reopening the spool (a client restart).
+// - A corrupted chunk read back (CRC) throws InputError naming the chunk; the spool's own I/O
+//   failures throw std::runtime_error with SQLite's message and the file.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <dynid/ingest/chunk.hpp>
+
+struct sqlite3;
+
+namespace dynid::car {
+
+class SpoolFull : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct SpoolEntry {
+  std::string vehicle;
+  std::string run;
+  std::uint64_t sequence = 0;
+  std::uint64_t bytes = 0;
+};
+
+class Spool {
+ public:
+  /// Opens (creating the directory and database if needed) the spool in `directory`.
+  Spool(const std::filesystem::path& directory, std::uint64_t max_bytes);
+  ~Spool();
+  Spool(const Spool&) = delete;
+  Spool& operator=(const Spool&) = delete;
+
+  void store(const ingest::Chunk& chunk);
+  void acknowledge(const std::string& vehicle, const std::string& run, std::uint64_t sequence);
+
+  /// The unacknowledged chunks, oldest first (decoded and CRC-checked).
+  std::vector<ingest::Chunk> pending() const;
+  /// The same, without reading the chunk bytes.
+  std::vector<SpoolEntry> pending_entries() const;
+  /// The highest acknowledged sequence of a run, if any.
+  std::optional<std::uint64_t> acknowledged(const std::string& vehicle, const std::string& run) const;
+
+  std::uint64_t bytes() const { return bytes_; }
+  std::uint64_t max_bytes() const { return max_bytes_; }
+  std::uint64_t count() const;
+  const std::filesystem::path& file() const { return file_; }
+
+ private:
+  void exec(const char* sql) const;
+  [[noreturn]] void fail(const std::string& what) const;
+  std::string full_message(std::uint64_t incoming) const;
+
+  std::filesystem::path file_;
+  std::uint64_t max_bytes_;
+  std::uint64_t bytes_ = 0;
+  sqlite3* db_ = nullptr;
+};
+
+}  // namespace dynid::car

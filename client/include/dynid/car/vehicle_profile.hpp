@@ -1,0 +1,113 @@
+#pragma once
+// VehicleProfile: everything the car side knows about one vehicle, read from a TOML file:
+// its id, its DBC, which buses to listen to, the grid, how DBC signals become catalogue channels
+// (docs/CHANNELS.md) in SI units, the vehicle's constants and model list for the server, and the
+// spool. Profiles, not code, describe a car.
+//
+// Format (deploy/profiles/rav4.toml is a complete example):
+//
+//   [vehicle]
+//   id = "rav4-2017"
+//   dbc = "../../dbc/toyota.dbc"       # relative to this profile file
+//   interfaces = ["can0"]              # optional: frames from other buses are ignored
+//   [grid]
+//   rate_hz = 50.0                     # uniform grid of every run
+//   chunk_seconds = 1.0                # must be a whole number of grid periods
+//   max_gap_periods = 2.5              # optional: see resampler.hpp
+//   [spool]
+//   directory = "spool"                # relative to this profile file unless absolute
+//   max_bytes = 1073741824
+//   [constants]                        # SI, shared by every model
+//   wheel_radius = 0.33
+//   [[models]]
+//   name = "longitudinal_engine"       # model registry name
+//   effects = ["road_grade"]           # optional
+//   constants = { driveline_efficiency = 0.9 }   # optional, added to / override [constants]
+//   [[channels]]
+//   name = "vx"                        # catalogue channel; its SI unit comes from the catalogue
+//   message = "WHEEL_SPEEDS"           # DBC message name
+//   signals = ["WHEEL_SPEED_FL", "WHEEL_SPEED_FR", "WHEEL_SPEED_RL", "WHEEL_SPEED_RR"]
+//   combine = "mean"                   # "sum" (default) or "mean" of the converted signals
+//   # optional: signal = "X" (one signal), dbc_unit = "bar" (when the DBC has none or a wrong
+//   # one), factor/offset (explicit DBC -> SI conversion instead of the unit table), scale and
+//   # divide_by (a number or the name of a [constants] entry, e.g. "steering_ratio"),
+//   # sign = -1, max_gap (seconds, instead of the derived window).
+//
+// Value of a channel sample: sign * scale / divide_by * combine_i(conv_i(dbc_value_i)), where
+// conv_i converts signal i from its DBC unit to the channel's SI unit. All signals of a channel
+// come from one message, so they share a timestamp and combining them needs no resampling.
+//
+// Contract: load_vehicle_profile() parses the DBC it names and checks every reference against it.
+// Every error throws InputError "<profile file>:<line>:<column>: <key>: <reason>" (line and
+// column when the key exists), for: TOML syntax, missing keys and wrong types, unknown or
+// duplicate channel, unknown DBC message or signal, a DBC that cannot be read, a missing unit
+// (empty DBC unit for a dimensioned channel and no dbc_unit/factor), an unconvertible unit,
+// a non-finite or non-positive number where one is required, an unknown model or a model whose
+// constants it rejects, an unknown constant name in scale/divide_by.
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <dynid/can/dbc.hpp>
+#include <dynid/ingest/run_announcement.hpp>
+#include <dynid/model/constants.hpp>
+
+#include "dynid/car/units.hpp"
+
+namespace dynid::car {
+
+enum class Combine { Sum, Mean };
+
+struct SignalInput {
+  std::string signal;
+  std::size_t index = 0;        ///< in can::Message::signals
+  std::string dbc_unit;         ///< the unit converted from ("" with an explicit factor)
+  LinearConversion to_si;       ///< DBC physical value -> channel SI unit
+};
+
+struct ChannelMapping {
+  std::string channel;  ///< catalogue name
+  std::string unit;     ///< its SI unit (catalogue)
+  std::string message;  ///< DBC message name
+  const can::Message* dbc_message = nullptr;  ///< into VehicleProfile::dbc
+  std::vector<SignalInput> inputs;
+  Combine combine = Combine::Sum;
+  double gain = 1.0;    ///< sign * scale / divide_by
+  std::optional<double> max_gap;  ///< seconds; unset: derived from the signal's period
+
+  /// The channel value from the message's decoded physical values (indexed like
+  /// can::Message::signals).
+  double value(const std::vector<double>& physical_by_signal) const;
+};
+
+struct VehicleProfile {
+  std::filesystem::path source;  ///< the profile file (or the name given to parse)
+  std::string vehicle;
+  std::filesystem::path dbc_path;
+  std::shared_ptr<const can::Database> dbc;
+  std::vector<std::string> interfaces;  ///< empty: every interface
+  double rate_hz = 0.0;
+  std::size_t chunk_rows = 0;
+  double max_gap_periods = 2.5;
+  std::vector<ChannelMapping> channels;  ///< the column order of every chunk
+  model::Constants constants;
+  std::vector<ingest::ModelSpec> models;
+  std::filesystem::path spool_directory;
+  std::uint64_t spool_max_bytes = 0;
+
+  bool accepts_interface(std::string_view name) const;
+  /// The announcement of a run of this vehicle (channels with units, rate, models).
+  ingest::RunAnnouncement announcement(const std::string& run) const;
+};
+
+VehicleProfile load_vehicle_profile(const std::filesystem::path& path);
+/// Parses profile text; `source` names it in messages and relative paths resolve against its
+/// parent folder.
+VehicleProfile parse_vehicle_profile(std::string_view text, const std::filesystem::path& source);
+
+}  // namespace dynid::car

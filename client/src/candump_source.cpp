@@ -1,0 +1,42 @@
+#include "dynid/car/candump_source.hpp"
+
+#include "dynid/error.hpp"
+
+namespace dynid::car {
+namespace {
+
+std::ifstream open_log(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open the CAN log");
+  return in;
+}
+
+}  // namespace
+
+CandumpSource::CandumpSource(const std::filesystem::path& path)
+    : file_(open_log(path)),
+      size_(std::filesystem::file_size(path)),
+      reader_(file_, path.filename().string(), can::OnError::Continue) {}
+
+NextStatus CandumpSource::next(can::Frame& frame, std::chrono::milliseconds /*timeout*/) {
+  if (ended_ || !reader_.next(frame)) {
+    ended_ = true;
+    return NextStatus::End;
+  }
+  return NextStatus::Frame;
+}
+
+double CandumpSource::fraction_done() const {
+  if (ended_ || size_ == 0) return 1.0;
+  const auto pos = file_.tellg();
+  if (pos < 0) return 1.0;
+  return static_cast<double>(pos) / static_cast<double>(size_);
+}
+
+std::vector<std::string> CandumpSource::errors() const {
+  std::vector<std::string> out;
+  for (const auto& e : reader_.errors()) out.push_back(reader_.describe(e));
+  return out;
+}
+
+}  // namespace dynid::car

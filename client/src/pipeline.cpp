@@ -1,0 +1,40 @@
+#include "dynid/car/pipeline.hpp"
+
+namespace dynid::car {
+namespace {
+
+ResamplerConfig resampler_config(const VehicleProfile& p) {
+  ResamplerConfig c;
+  c.rate_hz = p.rate_hz;
+  c.channels = p.channels.size();
+  c.max_gap_periods = p.max_gap_periods;
+  for (const auto& m : p.channels) c.max_gap.push_back(m.max_gap);
+  return c;
+}
+
+}  // namespace
+
+CarPipeline::CarPipeline(const VehicleProfile& profile, const std::string& run,
+                         ChunkBuilder::ChunkSink sink, std::uint64_t first_sequence)
+    : mapper_(profile),
+      builder_(profile.vehicle, run, profile.channels.size(), profile.chunk_rows, std::move(sink),
+               first_sequence),
+      resampler_(resampler_config(profile),
+                 [this](std::uint64_t k, std::span<const double> row, bool valid) {
+                   builder_.add_row(k, row, valid);
+                 }) {}
+
+void CarPipeline::on_frame(const can::Frame& frame) {
+  samples_.clear();
+  mapper_.map(frame, samples_);
+  for (const auto& s : samples_) resampler_.push(s.channel, s.time, s.value);
+  // Every frame moves the clock, so a silent channel is declared stale in time.
+  resampler_.advance_clock(frame.timestamp);
+}
+
+void CarPipeline::finish() {
+  resampler_.finish();
+  builder_.flush();
+}
+
+}  // namespace dynid::car

@@ -1,0 +1,153 @@
+#include "dynid/car/resampler.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dynid/error.hpp"
+
+namespace dynid::car {
+namespace {
+
+void check_config(const ResamplerConfig& c) {
+  if (!(c.rate_hz > 0.0) || !std::isfinite(c.rate_hz)) throw InputError("resampler: rate_hz must be > 0");
+  if (c.channels == 0) throw InputError("resampler: no channel");
+  if (!(c.max_gap_periods >= 1.0)) throw InputError("resampler: max_gap_periods must be >= 1");
+  if (!(c.max_latency > 0.0)) throw InputError("resampler: max_latency must be > 0");
+  if (!c.max_gap.empty() && c.max_gap.size() != c.channels)
+    throw InputError("resampler: max_gap has " + std::to_string(c.max_gap.size()) + " entries for " +
+                     std::to_string(c.channels) + " channels");
+  for (const auto& g : c.max_gap)
+    if (g && !(*g > 0.0)) throw InputError("resampler: a max_gap must be > 0");
+}
+
+}  // namespace
+
+Resampler::Resampler(ResamplerConfig config, RowSink sink)
+    : config_(std::move(config)), sink_(std::move(sink)) {
+  check_config(config_);
+  if (config_.max_gap.empty()) config_.max_gap.resize(config_.channels);
+  channels_.resize(config_.channels);
+  row_.resize(config_.channels);
+  stats_.missing_by_channel.assign(config_.channels, 0);
+  origin_ = config_.origin;
+}
+
+double Resampler::row_time(std::uint64_t k) const {
+  return *origin_ + static_cast<double>(k) / config_.rate_hz;
+}
+
+void Resampler::push(std::size_t channel, double time, double value) {
+  ++stats_.samples;
+  if (!origin_) origin_ = time;
+  Channel& c = channels_.at(channel);
+  if (!c.samples.empty() && !(time > c.samples.back().time)) {
+    ++stats_.out_of_order;
+    return;
+  }
+  bool bridgeable = false;
+  if (!c.samples.empty()) {
+    const double interval = time - c.samples.back().time;
+    bridgeable = interval <= judge_interval(channel, c, interval);
+  }
+  c.samples.push_back({time, value, bridgeable});
+  clock_ = std::max(clock_, time);
+  emit_ready();
+}
+
+void Resampler::advance_clock(double time) {
+  clock_ = std::max(clock_, time);
+  emit_ready();
+}
+
+// Records the interval and returns G_c for it: the override, or max_gap_periods x the lower
+// median of the recent intervals including this one (0 = not enough history to judge).
+double Resampler::judge_interval(std::size_t channel, Channel& c, double interval) {
+  c.intervals[c.interval_count % kPeriodWindow] = interval;
+  ++c.interval_count;
+  if (config_.max_gap[channel]) return *config_.max_gap[channel];
+  if (c.interval_count < kMinIntervals) return 0.0;
+  const std::size_t n = std::min(c.interval_count, kPeriodWindow);
+  std::array<double, kPeriodWindow> sorted = c.intervals;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>((n - 1) / 2),
+                   sorted.begin() + static_cast<long>(n));
+  return config_.max_gap_periods * sorted[(n - 1) / 2];
+}
+
+// How long after its last sample a channel can no longer bridge anything. A lower median of
+// the window plus one more interval never exceeds the window's maximum, so past
+// max_gap_periods x max(window) the next interval cannot be judged bridgeable: the stale
+// verdict agrees with the interpolation rule whatever arrives later.
+double Resampler::stale_after(std::size_t channel, const Channel& c) const {
+  if (config_.max_gap[channel]) return *config_.max_gap[channel];
+  if (c.interval_count + 1 < kMinIntervals) return 0.0;
+  const std::size_t n = std::min(c.interval_count, kPeriodWindow);
+  const double longest = *std::max_element(c.intervals.begin(), c.intervals.begin() + static_cast<long>(n));
+  return config_.max_gap_periods * longest;
+}
+
+bool Resampler::decided(std::size_t channel, double t) const {
+  const Channel& c = channels_[channel];
+  if (clock_ > t + config_.max_latency) return true;
+  if (c.samples.empty()) return false;
+  const double last = c.samples.back().time;
+  return last >= t || clock_ > last + stale_after(channel, c);
+}
+
+std::optional<double> Resampler::value_at(const Channel& c, double t) const {
+  const auto b = std::lower_bound(c.samples.begin(), c.samples.end(), t,
+                                  [](const Sample& s, double x) { return s.time < x; });
+  if (b == c.samples.end()) return std::nullopt;  // past the last sample: no extrapolation
+  if (b->time == t) return b->value;
+  if (b == c.samples.begin() || !b->bridgeable) return std::nullopt;  // before data, or a gap
+  const auto a = std::prev(b);
+  return a->value + (b->value - a->value) * ((t - a->time) / (b->time - a->time));
+}
+
+void Resampler::emit_ready() {
+  if (!origin_) return;
+  for (;;) {
+    const double t = row_time(next_row_);
+    for (std::size_t i = 0; i < channels_.size(); ++i)
+      if (!decided(i, t)) return;
+    emit_row(t);
+  }
+}
+
+void Resampler::finish() {
+  if (!origin_) return;
+  emit_ready();
+  double end = 0.0;
+  bool any = false;
+  for (const auto& c : channels_) {
+    if (c.samples.empty()) continue;
+    end = any ? std::min(end, c.samples.back().time) : c.samples.back().time;
+    any = true;
+  }
+  while (any && row_time(next_row_) <= end) emit_row(row_time(next_row_));
+}
+
+void Resampler::emit_row(double t) {
+  bool valid = true;
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    const auto v = value_at(channels_[i], t);
+    row_[i] = v.value_or(0.0);
+    if (!v) {
+      valid = false;
+      ++stats_.missing_by_channel[i];
+    }
+  }
+  if (!valid) std::fill(row_.begin(), row_.end(), 0.0);  // an invalid row carries zeros
+  ++stats_.rows;
+  if (!valid) ++stats_.invalid_rows;
+  sink_(next_row_, row_, valid);
+  ++next_row_;
+  const double next = row_time(next_row_);
+  for (auto& c : channels_) prune(c, next);
+}
+
+// Keeps the last sample at or before `t` (the lower bracket of the next row) and all after it.
+void Resampler::prune(Channel& c, double t) {
+  while (c.samples.size() >= 2 && c.samples[1].time <= t) c.samples.pop_front();
+}
+
+}  // namespace dynid::car

@@ -1,0 +1,348 @@
+#include "dynid/car/vehicle_profile.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include <dynid/model/registry.hpp>
+
+#include "dynid/car/channel_catalogue.hpp"
+#include "dynid/error.hpp"
+
+namespace dynid::car {
+namespace {
+
+// Reads one profile file: every failure names the file, the line:column of the offending node
+// when there is one, the key and the reason.
+class Reader {
+ public:
+  explicit Reader(std::filesystem::path source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& reason,
+                         const toml::node* node = nullptr) const {
+    std::string where = source_.string();
+    if (node != nullptr && node->source().begin.line > 0)
+      where += ":" + std::to_string(node->source().begin.line) + ":" +
+               std::to_string(node->source().begin.column);
+    throw InputError(where + ": " + key + ": " + reason);
+  }
+
+  const toml::table& table(const toml::table& parent, const std::string& key,
+                           const std::string& prefix = "") const {
+    const toml::node* n = parent.get(key);
+    if (n == nullptr) fail(prefix + key, "missing table");
+    if (!n->is_table()) fail(prefix + key, "expected a table", n);
+    return *n->as_table();
+  }
+
+  std::string string(const toml::table& t, const std::string& key, const std::string& full) const {
+    const toml::node* n = t.get(key);
+    if (n == nullptr) fail(full, "missing key");
+    auto v = n->value<std::string>();
+    if (!n->is_string() || !v) fail(full, "expected a string", n);
+    if (v->empty()) fail(full, "must not be empty", n);
+    return *v;
+  }
+
+  double number(const toml::node& n, const std::string& full) const {
+    if (!n.is_number()) fail(full, "expected a number", &n);
+    const double v = *n.value<double>();
+    if (!std::isfinite(v)) fail(full, "must be finite", &n);
+    return v;
+  }
+
+  double positive(const toml::table& t, const std::string& key, const std::string& full) const {
+    const toml::node* n = t.get(key);
+    if (n == nullptr) fail(full, "missing key");
+    const double v = number(*n, full);
+    if (!(v > 0.0)) fail(full, "must be > 0", n);
+    return v;
+  }
+
+  std::vector<std::string> strings(const toml::node& n, const std::string& full) const {
+    const toml::array* a = n.as_array();
+    if (a == nullptr) fail(full, "expected an array of strings", &n);
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::node& e = *a->get(i);
+      if (!e.is_string()) fail(full + "[" + std::to_string(i) + "]", "expected a string", &e);
+      out.push_back(*e.value<std::string>());
+    }
+    return out;
+  }
+
+  // Typos in optional keys would silently change a car's data: every key must be known.
+  void only_keys(const toml::table& t, std::initializer_list<std::string_view> known,
+                 const std::string& prefix) const {
+    for (const auto& [k, v] : t) {
+      bool ok = false;
+      for (auto name : known) ok = ok || k.str() == name;
+      if (!ok) fail(prefix + std::string(k.str()), "unknown key", &v);
+    }
+  }
+
+  std::filesystem::path relative_path(const std::string& p) const {
+    const std::filesystem::path path(p);
+    return path.is_absolute() ? path : source_.parent_path() / path;
+  }
+
+  const std::filesystem::path& source() const { return source_; }
+
+ private:
+  std::filesystem::path source_;
+};
+
+void read_vehicle(const Reader& r, const toml::table& root, VehicleProfile& p) {
+  const toml::table& v = r.table(root, "vehicle");
+  r.only_keys(v, {"id", "dbc", "interfaces"}, "vehicle.");
+  p.vehicle = r.string(v, "id", "vehicle.id");
+  p.dbc_path = r.relative_path(r.string(v, "dbc", "vehicle.dbc"));
+  try {
+    p.dbc = std::make_shared<const can::Database>(can::parse_dbc_file(p.dbc_path));
+  } catch (const std::exception& e) {
+    r.fail("vehicle.dbc", "cannot read the DBC '" + p.dbc_path.string() + "': " + e.what(),
+           v.get("dbc"));
+  }
+  if (const toml::node* n = v.get("interfaces")) p.interfaces = r.strings(*n, "vehicle.interfaces");
+}
+
+void read_grid(const Reader& r, const toml::table& root, VehicleProfile& p) {
+  const toml::table& g = r.table(root, "grid");
+  r.only_keys(g, {"rate_hz", "chunk_seconds", "max_gap_periods"}, "grid.");
+  p.rate_hz = r.positive(g, "rate_hz", "grid.rate_hz");
+  const double seconds = r.positive(g, "chunk_seconds", "grid.chunk_seconds");
+  const double rows = seconds * p.rate_hz;
+  if (std::abs(rows - std::round(rows)) > 1e-9 * rows || std::round(rows) < 1.0)
+    r.fail("grid.chunk_seconds", "must be a whole number (>= 1) of grid periods (1/rate_hz), got " +
+                                     std::to_string(rows) + " periods", g.get("chunk_seconds"));
+  p.chunk_rows = static_cast<std::size_t>(std::llround(rows));
+  if (g.contains("max_gap_periods")) {
+    p.max_gap_periods = r.positive(g, "max_gap_periods", "grid.max_gap_periods");
+    if (p.max_gap_periods < 1.0)
+      r.fail("grid.max_gap_periods", "must be >= 1 (a gap shorter than one period is no gap)",
+             g.get("max_gap_periods"));
+  }
+}
+
+void read_spool(const Reader& r, const toml::table& root, VehicleProfile& p) {
+  const toml::table& s = r.table(root, "spool");
+  r.only_keys(s, {"directory", "max_bytes"}, "spool.");
+  p.spool_directory = r.relative_path(r.string(s, "directory", "spool.directory"));
+  const toml::node* n = s.get("max_bytes");
+  if (n == nullptr) r.fail("spool.max_bytes", "missing key");
+  if (!n->is_integer()) r.fail("spool.max_bytes", "expected an integer (bytes)", n);
+  const auto bytes = *n->value<std::int64_t>();
+  if (bytes <= 0) r.fail("spool.max_bytes", "must be > 0", n);
+  p.spool_max_bytes = static_cast<std::uint64_t>(bytes);
+}
+
+model::Constants read_constants(const Reader& r, const toml::table& t, const std::string& prefix) {
+  model::Constants c;
+  for (const auto& [k, v] : t) c[std::string(k.str())] = r.number(v, prefix + std::string(k.str()));
+  return c;
+}
+
+void read_models(const Reader& r, const toml::table& root, VehicleProfile& p) {
+  const toml::node* n = root.get("models");
+  if (n == nullptr) return;  // a profile may only stream (no identification on the server yet)
+  const toml::array* models = n->as_array();
+  if (models == nullptr || !models->is_array_of_tables())
+    r.fail("models", "expected an array of tables ([[models]])", n);
+  for (std::size_t i = 0; i < models->size(); ++i) {
+    const std::string key = "models[" + std::to_string(i) + "]";
+    const toml::table& m = *models->get(i)->as_table();
+    r.only_keys(m, {"name", "effects", "constants"}, key + ".");
+    ingest::ModelSpec spec;
+    spec.model = r.string(m, "name", key + ".name");
+    spec.constants = p.constants;
+    if (const toml::node* c = m.get("constants")) {
+      if (!c->is_table()) r.fail(key + ".constants", "expected a table", c);
+      for (auto& [name, value] : read_constants(r, *c->as_table(), key + ".constants."))
+        spec.constants[name] = value;
+    }
+    if (const toml::node* e = m.get("effects")) spec.effects = r.strings(*e, key + ".effects");
+    try {
+      (void)model::make_model(spec.model, spec.constants);  // unknown model, missing constants
+    } catch (const InputError& e) {
+      r.fail(key + ".name", e.what(), m.get("name"));
+    }
+    p.models.push_back(std::move(spec));
+  }
+}
+
+// A gain term: a number, or the name of a [constants] entry (e.g. "steering_ratio").
+double gain_term(const Reader& r, const VehicleProfile& p, const toml::node& n, const std::string& key) {
+  double v = 0.0;
+  if (n.is_string()) {
+    const std::string name = *n.value<std::string>();
+    auto it = p.constants.find(name);
+    if (it == p.constants.end()) r.fail(key, "no constant '" + name + "' in [constants]", &n);
+    v = it->second;
+  } else {
+    v = r.number(n, key);
+  }
+  if (v == 0.0) r.fail(key, "must not be 0", &n);
+  return v;
+}
+
+LinearConversion input_conversion(const Reader& r, const toml::table& t, const std::string& key,
+                                  const ChannelMapping& m, const can::Signal& s, std::string& unit) {
+  if (t.contains("factor") || t.contains("offset")) {
+    const toml::node* f = t.get("factor");
+    const toml::node* o = t.get("offset");
+    unit.clear();
+    return {f ? r.number(*f, key + ".factor") : 1.0, o ? r.number(*o, key + ".offset") : 0.0};
+  }
+  unit = s.unit;
+  if (const toml::node* u = t.get("dbc_unit")) {
+    if (!u->is_string()) r.fail(key + ".dbc_unit", "expected a string", u);
+    unit = *u->value<std::string>();
+  }
+  const std::string what = "signal " + m.message + "." + s.name;
+  if (unit.empty()) {
+    // DBC files leave counts and states unitless; that is a unit only for a unitless channel.
+    if (m.unit == "-") return {};
+    r.fail(key + ".signals", "missing unit: " + what + " has no unit in the DBC and channel '" +
+                                 m.channel + "' needs '" + m.unit + "'; give dbc_unit or factor/offset",
+           t.get("signals") ? t.get("signals") : t.get("signal"));
+  }
+  auto c = conversion(unit, m.unit);
+  if (!c)
+    r.fail(key + ".signals", "cannot convert " + what + " from '" + unit + "' to '" + m.unit +
+                                 "' (channel '" + m.channel + "'); give dbc_unit or factor/offset",
+           t.get("signals") ? t.get("signals") : t.get("signal"));
+  return *c;
+}
+
+std::vector<std::string> signal_names(const Reader& r, const toml::table& t, const std::string& key) {
+  const toml::node* one = t.get("signal");
+  const toml::node* many = t.get("signals");
+  if ((one == nullptr) == (many == nullptr))
+    r.fail(key, "give exactly one of 'signal' or 'signals'", one ? one : many);
+  if (one != nullptr) return {r.string(t, "signal", key + ".signal")};
+  auto names = r.strings(*many, key + ".signals");
+  if (names.empty()) r.fail(key + ".signals", "must not be empty", many);
+  return names;
+}
+
+ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml::table& t,
+                            const std::string& key) {
+  r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
+                  "scale", "divide_by", "sign", "max_gap"},
+              key + ".");
+  ChannelMapping m;
+  m.channel = r.string(t, "name", key + ".name");
+  const auto unit = channel_unit(m.channel);
+  if (!unit) r.fail(key + ".name", "unknown channel '" + m.channel + "' (see docs/CHANNELS.md)", t.get("name"));
+  m.unit = *unit;
+  m.message = r.string(t, "message", key + ".message");
+  m.dbc_message = p.dbc->find_message(m.message);
+  if (m.dbc_message == nullptr)
+    r.fail(key + ".message", "unknown DBC message '" + m.message + "' in " + p.dbc_path.filename().string(),
+           t.get("message"));
+  for (const auto& name : signal_names(r, t, key)) {
+    auto index = m.dbc_message->signal_index(name);
+    if (!index)
+      r.fail(key + ".signals", "unknown DBC signal '" + name + "' in message '" + m.message + "' of " +
+                                   p.dbc_path.filename().string(),
+             t.get("signals") ? t.get("signals") : t.get("signal"));
+    SignalInput in{name, *index, {}, {}};
+    in.to_si = input_conversion(r, t, key, m, m.dbc_message->signals[*index], in.dbc_unit);
+    m.inputs.push_back(std::move(in));
+  }
+  if (const toml::node* c = t.get("combine")) {
+    const auto v = c->value<std::string>();
+    if (!c->is_string() || (*v != "sum" && *v != "mean"))
+      r.fail(key + ".combine", "expected \"sum\" or \"mean\"", c);
+    m.combine = *v == "mean" ? Combine::Mean : Combine::Sum;
+  }
+  if (const toml::node* s = t.get("scale")) m.gain *= gain_term(r, p, *s, key + ".scale");
+  if (const toml::node* d = t.get("divide_by")) m.gain /= gain_term(r, p, *d, key + ".divide_by");
+  if (const toml::node* s = t.get("sign")) {
+    const auto v = s->value<std::int64_t>();
+    if (!s->is_integer() || (*v != 1 && *v != -1)) r.fail(key + ".sign", "expected 1 or -1", s);
+    m.gain *= static_cast<double>(*v);
+  }
+  if (t.contains("max_gap")) m.max_gap = r.positive(t, "max_gap", key + ".max_gap");
+  return m;
+}
+
+void read_channels(const Reader& r, const toml::table& root, VehicleProfile& p) {
+  const toml::node* n = root.get("channels");
+  if (n == nullptr) r.fail("channels", "missing: at least one [[channels]] mapping");
+  const toml::array* a = n->as_array();
+  if (a == nullptr || !a->is_array_of_tables() || a->empty())
+    r.fail("channels", "expected a non-empty array of tables ([[channels]])", n);
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    const std::string key = "channels[" + std::to_string(i) + "]";
+    const toml::table& t = *a->get(i)->as_table();
+    ChannelMapping m = read_channel(r, p, t, key);
+    if (!seen.insert(m.channel).second)
+      r.fail(key + ".name", "duplicate channel '" + m.channel + "'", t.get("name"));
+    p.channels.push_back(std::move(m));
+  }
+}
+
+}  // namespace
+
+double ChannelMapping::value(const std::vector<double>& physical_by_signal) const {
+  double sum = 0.0;
+  for (const auto& in : inputs) sum += in.to_si.apply(physical_by_signal[in.index]);
+  if (combine == Combine::Mean) sum /= static_cast<double>(inputs.size());
+  return gain * sum;
+}
+
+bool VehicleProfile::accepts_interface(std::string_view name) const {
+  if (interfaces.empty()) return true;
+  for (const auto& i : interfaces)
+    if (i == name) return true;
+  return false;
+}
+
+ingest::RunAnnouncement VehicleProfile::announcement(const std::string& run) const {
+  ingest::RunAnnouncement a;
+  a.vehicle = vehicle;
+  a.run = run;
+  a.sample_rate_hz = rate_hz;
+  for (const auto& c : channels) a.channels.push_back({c.channel, c.unit});
+  a.models = models;
+  return a;
+}
+
+VehicleProfile parse_vehicle_profile(std::string_view text, const std::filesystem::path& source) {
+  const Reader r(source);
+  toml::table root;
+  try {
+    root = toml::parse(text, source.string());
+  } catch (const toml::parse_error& e) {
+    std::ostringstream msg;
+    msg << source.string() << ":" << e.source().begin.line << ":" << e.source().begin.column
+        << ": TOML syntax: " << e.description();
+    throw InputError(msg.str());
+  }
+  r.only_keys(root, {"vehicle", "grid", "spool", "constants", "models", "channels"}, "");
+  VehicleProfile p;
+  p.source = source;
+  read_vehicle(r, root, p);
+  read_grid(r, root, p);
+  read_spool(r, root, p);
+  if (root.contains("constants")) p.constants = read_constants(r, r.table(root, "constants"), "constants.");
+  read_models(r, root, p);
+  read_channels(r, root, p);
+  return p;
+}
+
+VehicleProfile load_vehicle_profile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open the vehicle profile");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_vehicle_profile(text.str(), path);
+}
+
+}  // namespace dynid::car
