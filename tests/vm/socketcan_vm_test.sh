@@ -1,17 +1,18 @@
 #!/usr/bin/env bash
 # Real-kernel test of the live SocketCAN path (see shared/notes/socketcan-vm.md): the build
 # machines' kernel has no CAN, so this boots Debian's own kernel under qemu (TCG, no network),
-# plays a candump log onto a vcan interface with canplayer, adds an extended-id, a remote and
-# CAN FD frames with cansend, and checks that dynid-socketcan-dump received exactly those frames
-# (ids, flags, payloads) with sane kernel timestamps (non-decreasing, wall-clock, paced like the
-# log).
+# plays a candump log onto a vcan interface with canplayer, adds an extended-id, a remote, CAN FD
+# and an error frame with cansend, and checks that dynid-socketcan-dump received exactly those
+# frames (ids, flags, payloads; the error frame counted, not returned) with sane kernel
+# timestamps (non-decreasing, wall-clock, paced like the log). Then: kernel filters, a time
+# limit on a silent bus and SIGTERM, each ending the dump cleanly.
 #
 #   socketcan_vm_test.sh --dump BIN --tool BIN --work DIR --cache DIR [--shared-data DIR]
 #
 # It installs what it needs (qemu-system-x86 busybox-static cpio can-utils iproute2) and
 # downloads the kernel package the linux-image-amd64 metapackage currently depends on (exact
 # name, cached in --cache). Anything it cannot get is a failure with the reason, never a skip.
-# Bounded: qemu runs under `timeout`, the whole test in about a minute.
+# Bounded: qemu runs under `timeout`; the whole test takes ~20 s on an idle machine.
 set -euo pipefail
 
 fail() { echo "socketcan_vm_test: FAIL: $*" >&2; exit 1; }
@@ -32,7 +33,7 @@ done
   fail "usage: --dump BIN --tool BIN --work DIR --cache DIR [--shared-data DIR]"
 
 readonly PACKAGES="qemu-system-x86 busybox-static cpio can-utils iproute2"
-readonly QEMU_SECONDS=90      # boot ~4 s under TCG, the log a few seconds: 90 s is a hang
+readonly QEMU_SECONDS=120     # ~15 s on an idle machine, ~50 s on a loaded one: 120 s is a hang
 readonly LOG_SECONDS=3        # of the real log (or of a generated one)
 readonly PLAYED_IFACE=can0
 
@@ -147,37 +148,70 @@ make_expected_log() {
   expected=$((played + ${#EXTRA_SEND[@]}))
 }
 
+# /init: the settings from here, then the fixed script (quoted: nothing expands on the host).
 write_init() {
-  cat >"$root/init" <<INIT
-#!/bin/busybox sh
+  {
+    echo '#!/bin/busybox sh'
+    echo "MODULES='${modules[*]}' EXPECTED=$expected PLAYED_IFACE=$PLAYED_IFACE"
+    echo "ERROR_SEND='$ERROR_SEND' EXTRA_SEND='${EXTRA_SEND[*]}'"
+    cat <<'INIT'
 /bin/busybox --install -s /bin
 export PATH=/bin:/opt/bin LD_LIBRARY_PATH=/lib/x86_64-linux-gnu:/usr/lib/x86_64-linux-gnu
-vmfail() { echo "DYNID-VM-FAIL \$*"; poweroff -f; }
+vmfail() { echo "DYNID-VM-FAIL $*"; poweroff -f; }
+# Waits until the dump whose stderr goes to $1 has bound its socket.
+ready() {
+  n=0
+  until grep -q "reading vcan0" "$1" 2>/dev/null; do
+    n=$((n + 1)); [ $n -gt 100 ] && { cat "$1"; vmfail "dump did not start"; }
+    sleep 0.1
+  done
+}
+section() { echo "DYNID-$1-BEGIN"; cat "$2"; echo "DYNID-$1-END"; }
+
 mount -t proc proc /proc && mount -t sysfs sysfs /sys && mount -t devtmpfs devtmpfs /dev ||
   vmfail "mount"
 # Dependencies first (add_module's order): a module needs the symbols of the ones before it.
-for m in ${modules[*]}; do insmod /lib/modules/\$m.ko || vmfail "insmod \$m"; done
-/opt/bin/ip link add dev vcan0 type vcan && /opt/bin/ip link set vcan0 mtu 72 &&
-  /opt/bin/ip link set up vcan0 || vmfail "vcan0"
-/opt/bin/dynid-socketcan-dump --frames $expected --seconds 60 --output /tmp/dump.log vcan0 \
+for m in $MODULES; do insmod /lib/modules/$m.ko || vmfail "insmod $m"; done
+ip link add dev vcan0 type vcan && ip link set vcan0 mtu 72 && ip link set up vcan0 ||
+  vmfail "vcan0"
+
+# 1. The log, then the extra frames and an error frame; ends after EXPECTED frames.
+dynid-socketcan-dump --frames $EXPECTED --seconds 60 --output /tmp/dump.log vcan0 \
   2>/tmp/dump.err &
-dump=\$!
-n=0
-until grep -q "reading vcan0" /tmp/dump.err 2>/dev/null; do
-  n=\$((n + 1)); [ \$n -gt 100 ] && { cat /tmp/dump.err; vmfail "dump did not start"; }
-  sleep 0.1
-done
-/opt/bin/canplayer -I /test/input.log vcan0=$PLAYED_IFACE || vmfail "canplayer"
-/opt/bin/cansend vcan0 $ERROR_SEND || vmfail "cansend $ERROR_SEND"
-for f in ${EXTRA_SEND[*]}; do /opt/bin/cansend vcan0 "\$f" || vmfail "cansend \$f"; done
-wait \$dump
-echo "DYNID-DUMP-STATUS \$?"
+dump=$!
+ready /tmp/dump.err
+canplayer -I /test/input.log vcan0=$PLAYED_IFACE || vmfail "canplayer"
+cansend vcan0 $ERROR_SEND || vmfail "cansend $ERROR_SEND"
+for f in $EXTRA_SEND; do cansend vcan0 "$f" || vmfail "cansend $f"; done
+wait $dump
+echo "DYNID-DUMP-STATUS $?"
 cat /tmp/dump.err
-echo "DYNID-DUMP-BEGIN"
-cat /tmp/dump.log
-echo "DYNID-DUMP-END"
+
+# 2. Kernel filters: a 29-bit exact id and an 11-bit one; 0x123 sent as a 29-bit id must not
+#    pass the 11-bit filter.
+dynid-socketcan-dump --frames 2 --seconds 20 --filter 1F334455 --filter 123:7FF \
+  --output /tmp/filter.log vcan0 2>/tmp/filter.err &
+dump=$!
+ready /tmp/filter.err
+for f in 023#01 1F334456#02 00000123#03 1F334455#04 124#05 123#06; do cansend vcan0 $f; done
+wait $dump
+echo "DYNID-FILTER-STATUS $?"
+
+# 3. A time limit with nothing on the bus, and SIGTERM: both end cleanly with 0 frames.
+dynid-socketcan-dump --seconds 1 --output /tmp/idle.log vcan0 2>/tmp/idle.err
+echo "DYNID-IDLE-STATUS $? $(grep -c . /tmp/idle.log)"
+dynid-socketcan-dump --output /tmp/term.log vcan0 2>/tmp/term.err &
+dump=$!
+ready /tmp/term.err
+kill -TERM $dump
+wait $dump
+echo "DYNID-TERM-STATUS $? $(grep -c . /tmp/term.log)"
+
+section DUMP /tmp/dump.log
+section FILTER /tmp/filter.log
 poweroff -f
 INIT
+  } >"$root/init"
   chmod +x "$root/init"
 }
 
@@ -200,6 +234,24 @@ build_initramfs() {
   (cd "$root" && find . | cpio -o -H newc --quiet | gzip -1) >"$work/initrd.gz"
 }
 
+# The lines between DYNID-<name>-BEGIN and DYNID-<name>-END of the serial log.
+section() {
+  sed -n "/^DYNID-$1-BEGIN\$/,/^DYNID-$1-END\$/p" "$work/serial.txt" | sed '1d;$d'
+}
+
+check_filter_and_stops() {
+  grep -E "^DYNID-(FILTER|IDLE|TERM)-STATUS" "$work/serial.txt"
+  local got
+  got=$(cut -d' ' -f3 "$work/filter.log" | tr '\n' ' ')
+  [ "$got" = "1F334455#04 123#06 " ] ||
+    fail "kernel filters 1F334455 and 123:7FF passed '$got', expected '1F334455#04 123#06 '"
+  grep -q "^DYNID-FILTER-STATUS 0$" "$work/serial.txt" || fail "the filtered dump failed"
+  grep -q "^DYNID-IDLE-STATUS 0 0$" "$work/serial.txt" ||
+    fail "--seconds 1 on a silent bus did not end cleanly with no frames"
+  grep -q "^DYNID-TERM-STATUS 0 0$" "$work/serial.txt" ||
+    fail "SIGTERM did not stop the dump cleanly (request_stop)"
+}
+
 run_vm() {
   local kernel
   kernel=$(ls "$kernel_root"/boot/vmlinuz-* | head -1)
@@ -219,11 +271,13 @@ run_vm() {
   fi
   grep -q "DYNID-DUMP-END" "$work/serial.txt" ||
     { tail -30 "$work/serial.txt" >&2; fail "no dump on the serial console"; }
-  sed -n '/^DYNID-DUMP-BEGIN$/,/^DYNID-DUMP-END$/p' "$work/serial.txt" | sed '1d;$d' >"$work/dump.log"
+  section DUMP >"$work/dump.log"
+  section FILTER >"$work/filter.log"
   grep -E "^(DYNID-DUMP-STATUS|dynid-socketcan-dump:)" "$work/serial.txt"
   grep -q "^DYNID-DUMP-STATUS 0$" "$work/serial.txt" || fail "dynid-socketcan-dump failed in the VM"
   grep -q "^dynid-socketcan-dump: $expected frames, 1 error frames, 0 dropped" "$work/serial.txt" ||
     fail "dynid-socketcan-dump did not count $expected frames, 1 error frame and no drops"
+  check_filter_and_stops
 }
 
 [ "$(uname -m)" = x86_64 ] || fail "needs an x86_64 host (qemu-system-x86_64 without KVM)"

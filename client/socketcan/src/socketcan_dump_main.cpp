@@ -1,8 +1,11 @@
 // dynid-socketcan-dump: reads one SocketCAN interface and writes what it receives as a candump
 // -l log with the project's writer, so the output compares line by line with canplayer's input.
 //
-//   dynid-socketcan-dump [--frames N] [--seconds T] [--output FILE] INTERFACE
+//   dynid-socketcan-dump [--frames N] [--seconds T] [--filter ID[:MASK]]... [--output FILE]
+//                        INTERFACE
 //
+// --filter takes hex as candump writes ids: 8 digits is a 29-bit id, fewer an 11-bit one; MASK
+// defaults to every id bit; several filters pass a frame any of them passes.
 // Stops after N frames, after T seconds, or on SIGINT/SIGTERM, whichever comes first (without
 // --frames and --seconds: only on a signal). Once the socket is bound it prints
 // "dynid-socketcan-dump: reading <interface>" on stderr, so a script can start the sender then;
@@ -17,6 +20,7 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 
@@ -32,16 +36,34 @@ struct Arguments {
   std::optional<std::uint64_t> frames;
   std::optional<double> seconds;
   std::string output;  // empty: stdout
+  dynid::car::SocketCanOptions options;
 };
 
 constexpr std::string_view kUsage =
-    "usage: dynid-socketcan-dump [--frames N] [--seconds T] [--output FILE] INTERFACE\n";
+    "usage: dynid-socketcan-dump [--frames N] [--seconds T] [--filter ID[:MASK]]... "
+    "[--output FILE] INTERFACE\n";
 
 // The source a signal handler stops; request_stop() is async-signal-safe.
 std::atomic<SocketCanSource*> g_source{nullptr};
 
 extern "C" void on_signal(int) {
   if (SocketCanSource* s = g_source.load()) s->request_stop();
+}
+
+std::uint32_t parse_hex(const std::string& text) {
+  std::size_t used = 0;
+  const unsigned long value = std::stoul(text, &used, 16);
+  if (used != text.size() || text.empty()) throw std::invalid_argument("not hex: " + text);
+  return static_cast<std::uint32_t>(value);
+}
+
+// "1F334455:1FFFFFFF" or "123"; the kernel-side range checks are SocketCanSource's.
+dynid::car::CanFilter parse_filter(const std::string& text) {
+  const std::size_t colon = text.find(':');
+  const std::string id = text.substr(0, colon);
+  dynid::car::CanFilter f = dynid::car::CanFilter::exact(parse_hex(id), id.size() == 8);
+  if (colon != std::string::npos) f.mask = parse_hex(text.substr(colon + 1));
+  return f;
 }
 
 std::optional<Arguments> parse(int argc, char** argv) {
@@ -54,6 +76,8 @@ std::optional<Arguments> parse(int argc, char** argv) {
         a.frames = std::stoull(argv[++i]);
       } else if (arg == "--seconds" && has_value) {
         a.seconds = std::stod(argv[++i]);
+      } else if (arg == "--filter" && has_value) {
+        a.options.filters.push_back(parse_filter(argv[++i]));
       } else if (arg == "--output" && has_value) {
         a.output = argv[++i];
       } else if (!arg.starts_with("-") && a.interface_name.empty()) {
@@ -61,7 +85,7 @@ std::optional<Arguments> parse(int argc, char** argv) {
       } else {
         return std::nullopt;
       }
-    } catch (const std::exception&) {  // stoull/stod on a non-number
+    } catch (const std::exception&) {  // stoull/stod/stoul on a non-number
       return std::nullopt;
     }
   }
@@ -105,7 +129,7 @@ int run(const Arguments& args) {
   }
   std::ostream& out = args.output.empty() ? std::cout : file;
 
-  SocketCanSource source(args.interface_name);
+  SocketCanSource source(args.interface_name, args.options);
   g_source.store(&source);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);

@@ -13,7 +13,8 @@
 //   bad_input()) and never returned. Timeout when nothing came within `timeout`; End after
 //   request_stop() (immediately, also while next() waits in another thread) or close().
 // - next() throws SocketCanError when the socket itself fails (interface removed or down).
-// - request_stop() is async-signal-safe and thread-safe, so a SIGINT handler may call it.
+// - next() and close() belong to one thread; request_stop() is async-signal-safe and may be
+//   called from any thread or a SIGINT handler (it wakes a next() waiting in poll()).
 // - Not copyable or movable (request_stop() may be called from a handler that holds a pointer).
 #include <atomic>
 #include <chrono>
