@@ -1,0 +1,165 @@
+#pragma once
+// Store: the server's durable archive (one SQLite file) of vehicles, run announcements, raw
+// chunks (the source of truth), the per-run ledger, accumulator checkpoints and estimate history.
+//
+// Durability. The file is in WAL mode with synchronous=FULL on every commit: a write function
+// that returns has had its transaction appended to the write-ahead log and fsync'd. So once
+// store_chunk() returns `stored` or `duplicate`, the chunk survives a crash of the process
+// (SIGKILL included) and of the operating system or a power cut, as far as the disk honours
+// fsync. That is the point at which the server may acknowledge it, and the only one. Every
+// write path is one transaction (BEGIN IMMEDIATE ... COMMIT): a write that throws has been
+// rolled back and leaves nothing half-written. A full disk (SQLITE_FULL) or an I/O error is a
+// StoreError naming the file; the chunk is then not stored and must not be acknowledged.
+//
+// Ordering (store_chunk). Sequences of a run start at 0. The ledger keeps the highest
+// *contiguous* sequence stored: every sequence 0..c is stored. The acknowledgement is that c,
+// never a sequence past a gap. A chunk past the gap (a resend overtook a lost chunk) is stored
+// ahead if its sequence is below c + 1 + reorder_window, so the car's later resend of the
+// missing chunk closes the gap and c jumps over everything already held; farther ahead it is
+// refused (`beyond_window`, nothing stored) and the car resends it later from its spool. The
+// window bounds what a misbehaving car can park in a gap. A chunk already stored with the same
+// bytes is `duplicate` (fine: re-acknowledge, e.g. after a lost acknowledgement); with other
+// bytes it is `conflict` (nothing changes; the stored chunk stays the truth).
+//
+// Folding. The ledger also keeps the highest sequence folded into the live accumulators
+// (mark_folded, monotonic, never past c). A checkpoint is the accumulators' state after folding
+// 0..folded_through; it is saved together with the ledger's folded mark in one transaction.
+// In-memory folds do not survive a restart, so opening the store resets every run's folded
+// mark to its latest checkpoint (or none): restart = latest_checkpoint(), then replay
+// chunks(folded_through + 1, highest_contiguous()). Nothing is lost, nothing folded twice.
+// Only a run's newest checkpoint is kept. A damaged one is reported (CorruptionError), and the
+// run can still be rebuilt by replaying its chunks from #0.
+//
+// Integrity. On open, PRAGMA quick_check (or integrity_check, or none: StoreOptions) must pass,
+// else CorruptionError naming the file. Every blob carries a CRC-32 that is checked when it
+// is read back (chunks also through decode_chunk): a damaged row is reported as
+// CorruptionError naming the file and its vehicle/run/sequence, never used.
+//
+// Bad input (errors.hpp): an unknown run or vehicle, an announcement that conflicts with the
+// stored one, a chunk that fails ingest::validate_chunk against its announcement, a new chunk
+// for a closed run, a ledger mark that would fold twice or fold what is not stored: InputError
+// naming what and why, and no state changes.
+//
+// One Store per file and process (the server owns it); not thread-safe: one thread at a time.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dynid/ingest/chunk.hpp"
+#include "dynid/ingest/run_announcement.hpp"
+#include "dynid/store/chunk_stream.hpp"
+#include "dynid/store/errors.hpp"
+
+namespace dynid::store {
+
+struct RunKey {
+  std::string vehicle;
+  std::string run;
+  auto operator<=>(const RunKey&) const = default;
+};
+
+struct StoreOptions {
+  enum class Check { none, quick, full };
+  /// What to verify on open: quick_check (O(file), skips index/content cross-checks) by default.
+  Check check_on_open = Check::quick;
+  /// A chunk is stored if its sequence < highest contiguous + 1 + reorder_window (>= 1; 1 means
+  /// strictly in order).
+  std::uint64_t reorder_window = 256;
+  /// Passed to ingest::validate_chunk.
+  ingest::ChunkLimits limits;
+  /// How long to wait for a lock held by another connection before SQLITE_BUSY.
+  int busy_timeout_ms = 5000;
+  /// A cap on the file's size in pages (PRAGMA max_page_count; 0 keeps SQLite's). Reaching it
+  /// behaves exactly like a full disk: SQLITE_FULL, a StoreError, nothing stored.
+  std::int64_t max_pages = 0;
+};
+
+enum class ChunkStatus {
+  stored,         ///< newly stored (in order or ahead of a gap)
+  duplicate,      ///< already stored with the same bytes
+  conflict,       ///< already stored with other bytes; nothing changed
+  beyond_window,  ///< too far past the contiguous prefix; nothing stored
+};
+
+struct StoreChunkResult {
+  ChunkStatus status = ChunkStatus::stored;
+  /// The acknowledgement: every sequence 0..contiguous_through of the run is durably stored.
+  std::optional<std::uint64_t> contiguous_through;
+  /// Why, for conflict and beyond_window.
+  std::string reason;
+};
+
+enum class AddRunResult { added, already_known };
+
+struct RunInfo {
+  std::string run;
+  bool closed = false;
+  std::optional<std::uint64_t> contiguous_through;
+  std::optional<std::uint64_t> folded_through;
+  std::uint64_t chunks_stored = 0;  ///< including chunks stored ahead of a gap
+};
+
+struct Checkpoint {
+  std::uint64_t folded_through = 0;  ///< state = accumulators after folding 0..folded_through
+  std::string state;
+};
+
+struct EstimateRecord {
+  std::string vehicle;
+  std::string model;
+  std::string scope;         ///< what was fitted: a run id, or a pool's name
+  std::int64_t time_ns = 0;  ///< nanoseconds since the Unix epoch
+  std::string encoded;       ///< the encoded estimate table
+};
+
+class Store {
+ public:
+  /// Opens or creates the file, checks it, brings its schema up to date and resets the folded
+  /// marks to the checkpoints. StoreError/CorruptionError name the file.
+  explicit Store(const std::string& path, StoreOptions options = {});
+  ~Store();
+  Store(Store&&) noexcept;
+  Store& operator=(Store&&) noexcept;
+
+  const std::string& path() const;
+
+  /// Records a run (and its vehicle on first sight) after announcement.validate(). The same
+  /// announcement again is `already_known`; a different one for the same vehicle/run is
+  /// InputError.
+  AddRunResult add_run(const ingest::RunAnnouncement& announcement);
+  /// The announcement as stored.
+  ingest::RunAnnouncement announcement(const RunKey& run);
+  /// Validates against the run's announcement, then stores durably (see Ordering above).
+  StoreChunkResult store_chunk(const ingest::Chunk& chunk);
+  std::optional<std::uint64_t> highest_contiguous(const RunKey& run);
+  std::optional<std::uint64_t> folded_through(const RunKey& run);
+  /// Chunks from..to (inclusive) in order; `to` must not exceed highest_contiguous().
+  ChunkStream chunks(const RunKey& run, std::uint64_t from, std::uint64_t to);
+  /// The live accumulators have folded 0..sequence.
+  void mark_folded(const RunKey& run, std::uint64_t sequence);
+  /// Saves the state after folding 0..folded_through and raises the folded mark to it, in one
+  /// transaction. folded_through must not exceed highest_contiguous() nor go below the latest
+  /// checkpoint's; the same checkpoint again is a no-op, a different one at the same mark is
+  /// InputError.
+  void save_checkpoint(const RunKey& run, std::uint64_t folded_through, std::string_view state);
+  std::optional<Checkpoint> latest_checkpoint(const RunKey& run);
+  /// Appends to the vehicle's estimate history (the vehicle must be known).
+  void record_estimate(const EstimateRecord& estimate);
+  /// A vehicle's estimates of one model, oldest first.
+  std::vector<EstimateRecord> estimate_history(const std::string& vehicle,
+                                               const std::string& model);
+  std::vector<std::string> list_vehicles();
+  /// Runs of a known vehicle in announcement order.
+  std::vector<RunInfo> list_runs(const std::string& vehicle);
+  /// No new chunk is accepted afterwards (duplicates still re-acknowledge). Idempotent.
+  void close_run(const RunKey& run);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dynid::store
