@@ -65,6 +65,28 @@ TEST(Derivative, StreamingHasOneSampleLookAheadAndEqualsOffline) {
   }
 }
 
+TEST(Derivative, StreamingStateRestoresExactlyAndIsChecked) {
+  const Eigen::MatrixXd x = test::test_signal(50, 2, 22u);
+  const Eigen::MatrixXd offline = derivative(x, 0.01);
+  for (Eigen::Index cut : {0, 1, 2, 3, 20}) {
+    StreamingDerivative first(2, 0.01);
+    Eigen::MatrixXd y(x.rows(), 2);
+    const Eigen::MatrixXd a = first.push(x.topRows(cut));
+    StreamingDerivative second(2, 0.01);
+    second.restore(first.state());
+    const Eigen::MatrixXd b = second.push(x.bottomRows(x.rows() - cut));
+    y << a, b, second.finish();
+    EXPECT_EQ(y, offline) << "cut at " << cut;
+  }
+  StreamingDerivative d(2, 0.01);
+  (void)d.push(x.topRows(10));
+  StreamingDerivative::State bad = d.state();
+  bad.samples_out = 3;
+  EXPECT_THROW(d.restore(bad), InputError);
+  EXPECT_THROW(StreamingDerivative(3, 0.01).restore(d.state()), InputError);
+  EXPECT_EQ(d.samples_out(), 9);
+}
+
 TEST(Derivative, RejectsShortOrNonFiniteInput) {
   EXPECT_THROW((void)derivative(Eigen::VectorXd::Ones(2), 0.01), InputError);
   EXPECT_THROW((void)derivative(Eigen::VectorXd::Ones(5), 0.0), InputError);

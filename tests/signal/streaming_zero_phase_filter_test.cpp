@@ -90,6 +90,51 @@ INSTANTIATE_TEST_SUITE_P(Designs, StreamingEqualsOffline,
                                          Case{4, 100.0, 1000.0}),
                          case_name);
 
+TEST(StreamingZeroPhaseFilter, OutputDoesNotDependOnTheChunkingToTheBit) {
+  // Backward sweeps start on the block grid, not at chunk ends: any chunking gives the same
+  // bits, which is what makes a server's streamed result equal to its one-chunk result.
+  const Sos sos = butterworth_lowpass(5, 4.0, 100.0);
+  StreamingZeroPhaseFilter filter(sos, 2, 1e-6);  // loose: chunk-dependent sweeps would show
+  const Eigen::MatrixXd x = test::test_signal(5 * filter.delay() + 77, 2, 11u);
+  const Eigen::MatrixXd whole = stream(filter, x, {x.rows()});
+  for (unsigned seed : {1u, 2u, 3u}) {
+    filter.reset();
+    const Eigen::MatrixXd chunked = stream(filter, x, random_sizes(2 * filter.block() + 3, seed));
+    EXPECT_EQ((chunked - whole).cwiseAbs().maxCoeff(), 0.0) << "seed " << seed;
+  }
+}
+
+TEST(StreamingZeroPhaseFilter, StateRestoresExactlyAndIsChecked) {
+  const Sos sos = butterworth_lowpass(4, 6.0, 100.0);
+  const Eigen::MatrixXd x = test::test_signal(900, 3, 5u);
+  StreamingZeroPhaseFilter whole(sos, 3);
+  const Eigen::MatrixXd expected = stream(whole, x, {x.rows()});
+  const Eigen::Index cuts[] = {0, 5, whole.padlen() + 3, 400};
+  for (Eigen::Index cut : cuts) {
+    StreamingZeroPhaseFilter first(sos, 3);
+    Eigen::MatrixXd got(x.rows(), 3);
+    const Eigen::MatrixXd a = first.push(x.topRows(cut));
+    got.topRows(a.rows()) = a;
+    StreamingZeroPhaseFilter second(sos, 3);
+    second.restore(first.state());
+    const Eigen::MatrixXd b = second.push(x.bottomRows(x.rows() - cut));
+    got.middleRows(a.rows(), b.rows()) = b;
+    got.bottomRows(x.rows() - a.rows() - b.rows()) = second.finish();
+    EXPECT_EQ((got - expected).cwiseAbs().maxCoeff(), 0.0) << "cut at " << cut;
+  }
+  StreamingZeroPhaseFilter other(sos, 2);
+  StreamingZeroPhaseFilter source(sos, 3);
+  (void)source.push(x.topRows(300));
+  EXPECT_THROW(other.restore(source.state()), InputError);  // channel count
+  StreamingZeroPhaseFilter::State bad = source.state();
+  bad.samples_in += 1;
+  EXPECT_THROW(source.restore(bad), InputError);
+  bad = source.state();
+  bad.pending(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(source.restore(bad), InputError);
+  EXPECT_EQ(source.samples_in(), 300);  // unchanged by the rejections
+}
+
 TEST(StreamingZeroPhaseFilter, LooseToleranceStillBoundsTheError) {
   // The overlap comes from the impulse-response tail: with a loose tolerance the error is
   // visible, and must stay within tolerance * max|x|.

@@ -47,6 +47,21 @@ Eigen::MatrixXd StreamingDerivative::push(const Eigen::MatrixXd& chunk) {
   return out;
 }
 
+void StreamingDerivative::restore(const State& s) {
+  const Eigen::Index pushed_out = s.samples_in >= 3 ? s.samples_in - 1 : 0;
+  const bool fits = s.samples_in >= 0 && s.recent.cols() == channels_ &&
+                    s.recent.rows() == std::min<Eigen::Index>(3, s.samples_in) &&
+                    s.samples_out == pushed_out + (s.finished ? 1 : 0) &&
+                    (!s.finished || s.samples_in >= 3) && s.recent.allFinite();
+  if (!fits)
+    throw InputError("StreamingDerivative::restore: the state does not fit (" +
+                     std::to_string(channels_) + " channels; counts, shape or values)");
+  n_in_ = s.samples_in;
+  n_out_ = s.samples_out;
+  finished_ = s.finished;
+  recent_ = s.recent;
+}
+
 Eigen::MatrixXd StreamingDerivative::finish() {
   const char* what = "StreamingDerivative::finish";
   if (finished_) throw InputError(std::string(what) + ": already finished");

@@ -93,7 +93,7 @@ void StreamingZeroPhaseFilter::reset() {
   finished_ = false;
   head_.resize(0, channels_);
   raw_tail_.resize(0, channels_);
-  forward_state_.resize(unit_state_.size(), channels_);
+  forward_state_.setZero(unit_state_.size(), channels_);  // defined before start: state() copies it
   pending_.resize(0, channels_);
   pending_rows_ = 0;
 }
@@ -115,8 +115,9 @@ Eigen::MatrixXd StreamingZeroPhaseFilter::push(const Eigen::MatrixXd& chunk) {
     head_.bottomRows(chunk.rows()) = chunk;
     if (n_in_ > padlen_) start_forward();
   }
-  const Eigen::Index ready = pending_rows_ - overlap_;
-  return ready >= block_ ? release(ready) : Eigen::MatrixXd(0, channels_);
+  // Whole blocks only: the block grid, not the chunk end, fixes where backward sweeps start.
+  const Eigen::Index blocks = std::max<Eigen::Index>(0, pending_rows_ - overlap_) / block_;
+  return blocks > 0 ? release(blocks) : Eigen::MatrixXd(0, channels_);
 }
 
 Eigen::MatrixXd StreamingZeroPhaseFilter::finish() {
@@ -179,17 +180,21 @@ void StreamingZeroPhaseFilter::forward_into_pending(const Eigen::MatrixXd& x) {
   pending_rows_ += m;
 }
 
-Eigen::MatrixXd StreamingZeroPhaseFilter::release(Eigen::Index count) {
-  // Backward from the newest forward output, started in steady state for its value: at least
-  // `overlap` samples of decay separate that start from every released sample.
+Eigen::MatrixXd StreamingZeroPhaseFilter::release(Eigen::Index blocks) {
+  // Block b (pending rows [b block, (b + 1) block)) is swept backward from the forward output
+  // `overlap` samples past its end, started in steady state for that value.
+  const Eigen::Index count = blocks * block_;
+  const Eigen::Index span = block_ + overlap_;
   Eigen::MatrixXd out(count, channels_);
-  Eigen::VectorXd sweep(pending_rows_);
+  Eigen::VectorXd sweep(span);
   Eigen::VectorXd z(unit_state_.size());
   for (Eigen::Index c = 0; c < channels_; ++c) {
-    sweep = pending_.col(c).head(pending_rows_);
-    z = unit_state_ * sweep(pending_rows_ - 1);
-    detail::run_backward(sos_, z.data(), sweep.data(), pending_rows_);
-    out.col(c) = sweep.head(count);
+    for (Eigen::Index b = 0; b < blocks; ++b) {
+      sweep = pending_.col(c).segment(b * block_, span);
+      z = unit_state_ * sweep(span - 1);
+      detail::run_backward(sos_, z.data(), sweep.data(), span);
+      out.col(c).segment(b * block_, block_) = sweep.head(block_);
+    }
   }
   const Eigen::Index left = pending_rows_ - count;
   pending_.topRows(left) = pending_.middleRows(count, left).eval();
@@ -198,6 +203,44 @@ Eigen::MatrixXd StreamingZeroPhaseFilter::release(Eigen::Index count) {
   const Eigen::Index usual = 2 * (overlap_ + block_);
   if (pending_.rows() > 2 * usual) pending_.conservativeResize(usual, Eigen::NoChange);
   return out;
+}
+
+StreamingZeroPhaseFilter::State StreamingZeroPhaseFilter::state() const {
+  return {n_in_, n_out_, finished_, head_, raw_tail_, forward_state_,
+          pending_.topRows(pending_rows_)};
+}
+
+void StreamingZeroPhaseFilter::check_state(const State& s) const {
+  const auto fail = [](const std::string& why) {
+    throw InputError("StreamingZeroPhaseFilter::restore: " + why);
+  };
+  const bool started = s.samples_in > padlen_;
+  if (s.samples_in < 0 || s.samples_out < 0 || s.samples_out > s.samples_in)
+    fail("sample counts out of range");
+  if (s.head.cols() != channels_ || s.raw_tail.cols() != channels_ ||
+      s.pending.cols() != channels_ || s.forward_state.cols() != channels_)
+    fail("channel count differs from the filter's " + std::to_string(channels_));
+  if (s.forward_state.rows() != unit_state_.size()) fail("forward state of another filter");
+  if (s.head.rows() != (started ? 0 : s.samples_in)) fail("raw head does not match the count");
+  if (s.raw_tail.rows() != std::min(s.samples_in, padlen_ + 1)) fail("raw tail length");
+  const Eigen::Index pending = started && !s.finished ? s.samples_in - s.samples_out : 0;
+  if (s.pending.rows() != pending) fail("pending forward outputs do not match the counts");
+  if (!s.finished && s.samples_out % block_ != 0) fail("output count off the block grid");
+  if (!s.head.allFinite() || !s.raw_tail.allFinite() || !s.forward_state.allFinite() ||
+      !s.pending.allFinite())
+    fail("non-finite value");
+}
+
+void StreamingZeroPhaseFilter::restore(const State& s) {
+  check_state(s);
+  n_in_ = s.samples_in;
+  n_out_ = s.samples_out;
+  finished_ = s.finished;
+  head_ = s.head;
+  raw_tail_ = s.raw_tail;
+  forward_state_ = s.forward_state;
+  pending_ = s.pending;
+  pending_rows_ = s.pending.rows();
 }
 
 }  // namespace dynid::signal

@@ -27,6 +27,18 @@ class StreamingDerivative {
   Eigen::MatrixXd finish();
   void reset();
 
+  // The complete state between calls, exact (for checkpoints): restored into a derivative of the
+  // same channel count and period, it continues the signal to the bit.
+  struct State {
+    Eigen::Index samples_in = 0;
+    Eigen::Index samples_out = 0;
+    bool finished = false;
+    Eigen::MatrixXd recent;  // the last min(samples_in, 3) samples, oldest first
+  };
+  State state() const { return {n_in_, n_out_, finished_, recent_}; }
+  // Throws InputError, leaving the object unchanged, when the state cannot be this object's.
+  void restore(const State& state);
+
   Eigen::Index samples_in() const { return n_in_; }
   Eigen::Index samples_out() const { return n_out_; }
 

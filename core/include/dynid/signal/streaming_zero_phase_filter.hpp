@@ -4,14 +4,21 @@
 //
 // How: the forward pass is causal, so it runs exactly as the offline filter runs it, once the
 // first padlen + 1 samples (needed for the odd extension at the start) are in. The backward pass
-// would need the whole future; instead, a sample k is released once `overlap` forward outputs
-// beyond it are known: the backward pass is started at the newest forward output j >= k +
-// overlap, from the steady state for that value. The error this makes at k is the filter's
-// impulse response beyond `overlap` samples applied to the (bounded) signal variation, so the
-// overlap is chosen from the filter's own decay (its impulse response tail) to keep
+// would need the whole future; instead, samples are released in fixed blocks of block() samples,
+// [b block, (b + 1) block), and block b is swept backward from forward output
+// (b + 1) block + overlap - 1, started from the steady state for that value: every released
+// sample has at least `overlap` samples of decay behind it. The error this makes at a sample is
+// the filter's impulse response beyond `overlap` samples applied to the (bounded) signal
+// variation, so the overlap is chosen from the filter's own decay (its impulse response tail) to keep
 //     |streamed - zero_phase_filter(whole signal)| <= tolerance * max|x|   (per channel).
 // finish() handles the end exactly as the offline filter does (odd extension, steady state), so
 // the last samples, and the first ones, match the offline filter to rounding error.
+//
+// Chunking invariance: where a backward sweep starts depends only on the sample index (the
+// block grid), never on where the chunks end, and every operation runs sample by sample, so the
+// output is the same to the bit however the signal is cut into chunks (what lets a server's
+// result equal the offline processing of the same data). The price: each block costs a backward
+// sweep of overlap + block samples, about 1 + overlap / block = 5 backward steps per sample.
 //
 // Delay rule: output sample k is returned by the push() that brings the number of input samples
 // to at least k + delay() + 1, with delay() = overlap() + block() - 1 and block() =
@@ -44,6 +51,22 @@ class StreamingZeroPhaseFilter {
   // Forgets the signal, keeps the filter: ready for a new one.
   void reset();
 
+  // The complete state between calls, exact: restored into a filter built with the same Sos,
+  // channel count and tolerance, it continues the signal to the bit (for checkpoints).
+  struct State {
+    Eigen::Index samples_in = 0;
+    Eigen::Index samples_out = 0;
+    bool finished = false;
+    Eigen::MatrixXd head;           // raw samples while fewer than padlen + 1 are in
+    Eigen::MatrixXd raw_tail;       // the last min(samples_in, padlen + 1) raw samples
+    Eigen::MatrixXd forward_state;  // 2 per section x channels
+    Eigen::MatrixXd pending;        // forward outputs not yet released (samples_out onwards)
+  };
+  State state() const;
+  // Throws InputError, leaving the filter unchanged, when the state cannot be this filter's
+  // (shapes, counts, block alignment, non-finite values).
+  void restore(const State& state);
+
   Eigen::Index channels() const { return channels_; }
   Eigen::Index padlen() const { return padlen_; }
   Eigen::Index overlap() const { return overlap_; }
@@ -59,7 +82,8 @@ class StreamingZeroPhaseFilter {
  private:
   void start_forward();
   void forward_into_pending(const Eigen::MatrixXd& x);
-  Eigen::MatrixXd release(Eigen::Index count);
+  Eigen::MatrixXd release(Eigen::Index blocks);
+  void check_state(const State& state) const;
   void keep_raw_tail(const Eigen::MatrixXd& chunk);
 
   Sos sos_;
