@@ -10,11 +10,11 @@
 //
 // The checksum is CRC-32 (zlib) over a canonical little-endian encoding of every field but the
 // checksum itself: it is what the server checks before storing, and what it stores.
+#include <Eigen/Core>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "dynid/ingest/run_announcement.hpp"
 
@@ -24,6 +24,9 @@ namespace dynid::ingest {
 struct ChunkLimits {
   Eigen::Index max_rows = 100000;
   Eigen::Index max_channels = 1024;
+  /// Largest |value| accepted: nothing a vehicle channel in SI reaches (pressures ~1e7 Pa),
+  /// and far enough from overflow that squares and sums in the accumulators stay finite.
+  double max_abs_value = 1e15;
 };
 
 struct Chunk {
@@ -31,8 +34,8 @@ struct Chunk {
   std::string run;
   std::uint64_t sequence = 0;
   std::uint64_t first_sample_index = 0;
-  Eigen::MatrixXd samples;           ///< rows x channels
-  std::vector<std::uint8_t> valid;   ///< one flag per row (1 valid, 0 gap)
+  Eigen::MatrixXd samples;          ///< rows x channels
+  std::vector<std::uint8_t> valid;  ///< one flag per row (1 valid, 0 gap)
   std::uint32_t checksum = 0;
 
   /// CRC-32 of the canonical encoding (everything but `checksum`).
@@ -42,9 +45,15 @@ struct Chunk {
 };
 
 /// Checks a chunk against its run: ids match, dimensions (columns = announced channels, rows
-/// within limits and > 0, one valid flag per row, flags 0/1), every value finite, checksum
-/// right. Throws InputError naming the chunk (vehicle/run#sequence) and the reason (for a
-/// non-finite value: row, channel name). Sequence order is the caller's (the ledger's) concern.
+/// within limits and > 0, one valid flag per row, flags 0/1), checksum right, every value finite
+/// and within limits.max_abs_value. Throws InputError naming the chunk (vehicle/run#sequence)
+/// and the reason (for a bad value: row, channel name). Sequence order is the caller's (the
+/// ledger's) concern.
+///
+/// Encoding (version 1, little-endian): "DYNIDCHK", u16 version, vehicle and run (u32 length +
+/// bytes), u64 sequence, u64 first_sample_index, u64 rows, u64 columns, the samples row by row
+/// as binary64, u64 flag count and the flags (one byte each), then the u32 checksum. The checksum
+/// is the CRC-32 of everything before it, so compute_checksum() is defined by this layout.
 void validate_chunk(const Chunk& chunk, const RunAnnouncement& run, const ChunkLimits& limits = {});
 
 /// Exact binary encoding of a chunk (for the store and the spool) and its inverse, which

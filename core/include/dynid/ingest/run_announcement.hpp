@@ -6,9 +6,17 @@
 //
 // Contract: validate() throws InputError naming the field and the reason for an empty vehicle or
 // run id, a non-positive or non-finite sample rate, no channel, a duplicate or empty channel
-// name, a model spec without a name, a non-finite constant.
+// name, a model spec without a name, a non-finite constant, preprocessing settings out of range
+// (Butterworth order outside 1..8, a cut-off not strictly inside (0, fs/2), odmf < 1, a filter
+// tolerance outside [1e-13, 1e-3]).
+//
+// encode_announcement()/decode_announcement() are an exact, versioned, checksummed binary form
+// (little-endian); the server stores it and a run checkpoint carries its checksum, so a
+// checkpoint is never restored under another announcement.
+#include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace dynid::ingest {
@@ -24,16 +32,40 @@ struct ModelSpec {
   std::vector<std::string> effects;         ///< enabled candidate effects
 };
 
+/// How the server preprocesses the run (DYCARO's script_filtre; venture-2003 §4.3): every
+/// channel but the `unfiltered` ones goes through one zero-phase Butterworth low-pass, and the
+/// `d_<name>` channels the models need are its central differences. Defaults follow the
+/// source's settings (order 5; cut-off 0.8 fs / (2 odmf)).
+struct Preprocessing {
+  int butterworth_order = 5;  ///< DYCARO's nbutter, 1..8
+  double cutoff_hz = 0.0;     ///< -3 dB cut-off; 0 means DYCARO's rule 0.8 fs / (2 odmf)
+  int odmf = 8;               ///< DYCARO's cut-off divisor, used when cutoff_hz == 0
+  /// Bound on |streamed - offline zero-phase filter| relative to max|x| (per segment).
+  double filter_tolerance = 1e-10;
+  /// Channels passed through as they are (delayed to stay aligned): discrete ones, which a
+  /// low-pass would smear across a gear change. Names not announced are ignored.
+  std::vector<std::string> unfiltered = {"gear", "gear_ratio"};
+
+  /// The cut-off actually used, Hz.
+  double cutoff(double sample_rate_hz) const;
+};
+
 struct RunAnnouncement {
   std::string vehicle;  ///< vehicle id, e.g. "proto-17"
   std::string run;      ///< run id, unique per vehicle
   double sample_rate_hz = 0.0;
   std::vector<ChannelSpec> channels;  ///< column order of every chunk
   std::vector<ModelSpec> models;
+  Preprocessing preprocessing;
 
   void validate() const;
   /// Index of a channel's column; throws InputError naming an unknown channel.
   std::size_t column_of(const std::string& channel) const;
 };
+
+std::string encode_announcement(const RunAnnouncement& announcement);
+/// Inverse of encode_announcement(); throws InputError on truncated, corrupted (checksum) or
+/// trailing bytes. The result is not validated: call validate().
+RunAnnouncement decode_announcement(std::string_view bytes);
 
 }  // namespace dynid::ingest

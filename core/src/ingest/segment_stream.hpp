@@ -1,0 +1,84 @@
+#pragma once
+// Private to the ingest area: the preprocessing of one valid segment of a run (low-pass,
+// pass-through of discrete channels, derivatives) and the window of final samples the models
+// read. Segment indices count samples from the segment's first one.
+//
+// Window: rows [window_first, window_first + window_rows) of the segment, columns = the
+// announced channels then the derived ones. A row's announced columns are known once the filter
+// released it, its derived columns once the derivative did (derived_end). Rows are built for
+// [built, ready_end) with kReachBack rows of context before and, until the segment ends,
+// kReachAhead rows after; consume() then drops what no later row can reach.
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "byte_codec.hpp"
+#include "dynid/signal/derivative.hpp"
+#include "dynid/signal/streaming_zero_phase_filter.hpp"
+
+namespace dynid::ingest::detail {
+
+/// Which announced columns are filtered or passed through, and where derived channels come from.
+struct Layout {
+  std::vector<Eigen::Index> filtered;
+  std::vector<Eigen::Index> unfiltered;
+  std::vector<Eigen::Index> derived_from;  ///< per derived channel, its announced column
+  Eigen::Index announced = 0;
+  Eigen::Index width() const { return announced + static_cast<Eigen::Index>(derived_from.size()); }
+};
+
+/// What the models may read now: `rows` (a block of the window) of which rows
+/// [first_new, first_new + new_count) are the ones to build.
+struct ReadyRows {
+  Eigen::Block<const Eigen::MatrixXd> rows;
+  Eigen::Index first_new;
+  Eigen::Index new_count;
+};
+
+class SegmentStream {
+ public:
+  SegmentStream(const signal::Sos& sos, Layout layout, double sample_period, double tolerance);
+
+  /// Starts a new segment at grid index `start` (forgets the previous one).
+  void start(std::uint64_t start);
+  void stop() { active_ = false; }
+  bool active() const { return active_; }
+  std::uint64_t start_index() const { return start_; }
+  Eigen::Index length() const { return filter_.samples_in(); }
+  /// Enough samples for the edge extension (otherwise the segment is skipped).
+  bool long_enough() const { return filter_.samples_in() > filter_.padlen(); }
+  Eigen::Index delay() const { return filter_.delay(); }
+
+  /// Raw valid rows of the segment (all announced columns), in order.
+  void push(const Eigen::Ref<const Eigen::MatrixXd>& raw);
+  /// Ends the segment: every sample becomes final. Needs long_enough().
+  void finish();
+
+  ReadyRows ready(bool at_end) const;
+  /// Marks the `count` rows of the last ready() built; drops rows no later row reaches.
+  void consume(Eigen::Index count);
+
+  void save(ByteWriter& w) const;
+  /// Throws InputError (via the reader or the signal classes) when the state does not fit.
+  void load(ByteReader& r);
+
+ private:
+  void append_final(const Eigen::MatrixXd& filtered);
+  void reserve_window(Eigen::Index rows);
+
+  Layout layout_;
+  signal::StreamingZeroPhaseFilter filter_;
+  std::optional<signal::StreamingDerivative> derivative_;
+  bool active_ = false;
+  std::uint64_t start_ = 0;
+  Eigen::MatrixXd fifo_;  // pass-through channels of samples the filter holds back
+  Eigen::Index fifo_rows_ = 0;
+  Eigen::MatrixXd window_;
+  Eigen::Index window_first_ = 0;
+  Eigen::Index window_rows_ = 0;
+  Eigen::Index derived_end_ = 0;
+  Eigen::Index built_ = 0;
+};
+
+}  // namespace dynid::ingest::detail

@@ -1,0 +1,126 @@
+#pragma once
+// Test runs for the ingest tests, generated here with known physics (no mock of our parts):
+// a car on a flat road at 100 Hz whose speed varies smoothly,
+//   wheel_torque = r_w (M dvx + 1/2 rho SCx vx|vx| + F_r)            (longitudinal_wheel)
+//   ax           = dvx + offset                                         (kinematic_longitudinal)
+//   engine_torque = J dw + p + q w + r w^2, w = engine_speed = G vx / r_w  (locked_driveline)
+// plus sensor noise, a gear channel (3, with a short stretch in 2), and gaps: a long one, a
+// valid stretch too short to filter, and a gap whose values are garbage (must not matter).
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "dynid/error.hpp"
+#include "dynid/ingest/chunk.hpp"
+#include "dynid/ingest/run_announcement.hpp"
+
+namespace dynid::ingest::test {
+
+struct Truth {
+  double mass = 1450.0, scx = 0.72, rolling = 160.0;           // longitudinal
+  double scale = 1.0, offset = 0.12;                           // kinematic
+  double inertia = 0.9, p = 12.0, q = 0.05, r = 4e-4;          // driveline (gear 3)
+  double wheel_radius = 0.31, air_density = 1.2, ratio = 3.9;  // constants
+};
+
+struct TestRun {
+  RunAnnouncement announcement;
+  Eigen::MatrixXd samples;  // grid rows x channels
+  std::vector<std::uint8_t> valid;
+};
+
+inline RunAnnouncement announcement_for(const Truth& t) {
+  RunAnnouncement a;
+  a.vehicle = "proto-17";
+  a.run = "run-0042";
+  a.sample_rate_hz = 100.0;
+  a.channels = {{"vx", "m/s"},
+                {"ax", "m/s^2"},
+                {"wheel_torque", "N m"},
+                {"engine_speed", "rad/s"},
+                {"engine_torque", "N m"},
+                {"gear", "-"}};
+  a.models = {{"longitudinal_wheel",
+               {{"wheel_radius", t.wheel_radius}, {"air_density", t.air_density}},
+               {}},
+              {"kinematic_longitudinal", {}, {"dict:lag2:vx"}},
+              {"locked_driveline", {{"gear", 3.0}}, {}}};
+  a.preprocessing.odmf = 5;  // 8 Hz at 100 Hz
+  return a;
+}
+
+inline TestRun make_run(Eigen::Index n = 6000, unsigned seed = 1u, const Truth& t = {}) {
+  TestRun run{announcement_for(t), Eigen::MatrixXd(n, 6), std::vector<std::uint8_t>(n, 1)};
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double s = static_cast<double>(k) / 100.0;
+    const double vx =
+        18.0 + 6.0 * std::sin(0.21 * s) + 2.5 * std::sin(0.67 * s + 1.0) + 0.8 * std::sin(1.9 * s);
+    const double dvx = 6.0 * 0.21 * std::cos(0.21 * s) + 2.5 * 0.67 * std::cos(0.67 * s + 1.0) +
+                       0.8 * 1.9 * std::cos(1.9 * s);
+    const double force = t.mass * dvx + 0.5 * t.air_density * t.scx * vx * std::abs(vx) + t.rolling;
+    const double w = t.ratio * vx / t.wheel_radius;
+    const double dw = t.ratio * dvx / t.wheel_radius;
+    const bool second = k >= 4100 && k < 4400;
+    run.samples(k, 0) = vx + 0.01 * noise(rng);
+    run.samples(k, 1) = t.scale * dvx + t.offset + 0.05 * noise(rng);
+    run.samples(k, 2) = t.wheel_radius * force + 5.0 * noise(rng);
+    run.samples(k, 3) = w + 0.05 * noise(rng);
+    run.samples(k, 4) = t.inertia * dw + t.p + t.q * w + t.r * w * w + 0.5 * noise(rng);
+    run.samples(k, 5) = second ? 2.0 : 3.0;
+  }
+  const auto gap = [&](Eigen::Index first, Eigen::Index count, double value) {
+    for (Eigen::Index k = first; k < std::min(n, first + count); ++k) {
+      run.valid[static_cast<std::size_t>(k)] = 0;
+      run.samples.row(k).setConstant(value);
+    }
+  };
+  gap(1500, 40, 0.0);    // a gap
+  gap(1550, 10, 0.0);    // after a 10-sample valid stretch: too short to filter
+  gap(3000, 25, 1.0e9);  // garbage in a gap must not matter
+  return run;
+}
+
+/// Cuts [first, first + count) of the run into a sealed chunk.
+inline Chunk cut(const TestRun& run, std::uint64_t sequence, Eigen::Index first,
+                 Eigen::Index count) {
+  Chunk c;
+  c.vehicle = run.announcement.vehicle;
+  c.run = run.announcement.run;
+  c.sequence = sequence;
+  c.first_sample_index = static_cast<std::uint64_t>(first);
+  c.samples = run.samples.middleRows(first, count);
+  c.valid.assign(run.valid.begin() + first, run.valid.begin() + first + count);
+  c.seal();
+  return c;
+}
+
+/// Chunk boundaries: random sizes in [1, largest], covering the run.
+inline std::vector<Eigen::Index> random_cuts(Eigen::Index n, Eigen::Index largest, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<Eigen::Index> size(1, largest);
+  std::vector<Eigen::Index> sizes;
+  for (Eigen::Index done = 0; done < n;) {
+    sizes.push_back(std::min(size(rng), n - done));
+    done += sizes.back();
+  }
+  return sizes;
+}
+
+template <class Call>
+void expect_input_error(Call call, const std::vector<std::string>& words) {
+  try {
+    call();
+    ADD_FAILURE() << "accepted; expected an InputError";
+  } catch (const InputError& e) {
+    for (const std::string& w : words)
+      EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << e.what() << " lacks " << w;
+  }
+}
+
+}  // namespace dynid::ingest::test
