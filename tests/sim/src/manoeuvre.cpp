@@ -132,7 +132,6 @@ void Driver::launch(double t, const State& s, DriverInputs& in) {
 
 void Driver::accelerate(double t, const State& s, DriverInputs& in) {
   const auto& d = model_.car.driveline;
-  const double since = t - phase_start_;
   const double half = 0.5 * spec_.shift_time;
   in.throttle_torque = spec_.drive_torque *
                        (1.0 + spec_.torque_variation * std::sin(2.0 * std::numbers::pi * kVariationFrequency * t));
@@ -141,6 +140,9 @@ void Driver::accelerate(double t, const State& s, DriverInputs& in) {
     phase_ = Phase::ShiftOut;
     phase_start_ = t;
   }
+  // Measured from the phase just entered: taken before the transition above it was the time
+  // since the previous phase began, and the clutch never opened (the gear changed at once).
+  const double since = t - phase_start_;
   if (phase_ == Phase::ShiftOut) {
     in.clamp_load = 0.0;
     in.throttle_torque = 0.0;

@@ -37,7 +37,9 @@ struct ManoeuvreSpec {
   double drive_torque = 150.0;    // lift-off (until start_time), acceleration, N m
   double torque_variation = 0.3;  // launch/acceleration: relative sinusoidal throttle variation
   double shift_speed = 420.0;     // acceleration: upshift engine speed, rad/s
-  double shift_time = 0.8;        // acceleration: clutch open then re-engaging, s
+  double shift_time = 0.8;        // acceleration: clutch open (throttle off) for half, then
+                                  // re-engaging for half, s. (Until the accuracy work the open
+                                  // half was skipped: the phase clock was read before the switch.)
   double launch_engine_speed = 170.0;  // launch: engine speed the driver aims at, rad/s
   double engagement_time = 1.5;   // launch: clamp load 0 -> max, s
   double rev_limit = 450.0;       // launch: stop driving when the engine reaches this, rad/s
