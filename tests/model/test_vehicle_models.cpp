@@ -148,6 +148,63 @@ TEST(LateralBicycle, UnknownMassRecoversPerUnitMassQuantities) {
                                        {"rear_cornering_stiffness_per_mass", kCr / kMass}});
 }
 
+// A body-fixed accelerometer on a rolling body reads ay cos(roll) + az sin(roll) (az ~ +g): with
+// the roll channel the model turns it back to the road plane and recovers the truth exactly.
+TEST(LateralBicycle, RollChannelRemovesGravityFromTheAccelerometer) {
+  const model::ChannelSet clean = bicycle_run();
+  const Eigen::Index n = clean.samples();
+  model::ChannelSet set(clean.sample_period(), n);
+  for (const auto& name : clean.names())
+    if (name != "ay") set.add(name, clean.unit(name), clean[name]);
+  Eigen::VectorXd roll(n), ay(n), az(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    roll(k) = 0.006 * clean["ay"](k) + 0.004 * clean["d_yaw_rate"](k);  // any roll history
+    az(k) = kG + 0.3 * std::sin(0.01 * static_cast<double>(k));        // heave too
+    // Specific force in the road plane (y_road, z_road) seen in body axes rolled by `roll`:
+    // z_road = az cos - ay sin, and y_road = ay cos - az sin must equal the clean ay.
+    const double c = std::cos(roll(k)), sn = std::sin(roll(k));
+    ay(k) = (clean["ay"](k) + az(k) * sn) / c;
+  }
+  set.add("ay", "m/s^2", ay);
+  set.add("az", "m/s^2", az);
+  set.add("roll", "rad", roll);
+  const auto m =
+      model::make_model("lateral_bicycle", {{"a", kA}, {"b", kB}, {"mass", kMass}, {"imu_x", kImuX}});
+  expect_recovered(identify(*m, set), {{"yaw_inertia", kYaw},
+                                       {"front_cornering_stiffness", kCf},
+                                       {"rear_cornering_stiffness", kCr}});
+}
+
+// Constant slip-angle offsets e_f, e_r on both axles (what steer, vy and yaw-rate sensor
+// offsets give at a steady speed): slip_offset recovers C_f e_f and C_r e_r exactly.
+TEST(LateralBicycle, SlipOffsetRecoversConstantSlipAngleOffsets) {
+  const model::ChannelSet clean = bicycle_run();
+  const Eigen::Index n = clean.samples();
+  constexpr double kEf = 0.002, kEr = -0.001;
+  model::ChannelSet set(clean.sample_period(), n);
+  for (const auto& name : clean.names())
+    if (name != "ay" && name != "d_yaw_rate") set.add(name, clean.unit(name), clean[name]);
+  // The car's forces carry the offsets; ay and dr/dt are those of the true forces.
+  Eigen::VectorXd ay(n), dr(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double vx = clean["vx"](k), vy = clean["vy"](k), r = clean["yaw_rate"](k), d = clean["steer"](k);
+    const double fyf = kCf * (d - std::atan((vy + kA * r) / vx) + kEf) * std::cos(d);
+    const double fyr = kCr * (-std::atan((vy - kB * r) / vx) + kEr);
+    dr(k) = (kA * fyf - kB * fyr) / kYaw;
+    ay(k) = (fyf + fyr) / kMass + kImuX * dr(k);
+  }
+  set.add("ay", "m/s^2", ay);
+  set.add("d_yaw_rate", "rad/s^2", dr);
+  const auto m =
+      model::make_model("lateral_bicycle", {{"a", kA}, {"b", kB}, {"mass", kMass}, {"imu_x", kImuX}});
+  expect_recovered(identify(*m, set, {"slip_offset"}),
+                   {{"yaw_inertia", kYaw},
+                    {"front_cornering_stiffness", kCf},
+                    {"rear_cornering_stiffness", kCr},
+                    {"front_slip_offset_force", kCf * kEf},
+                    {"rear_slip_offset_force", kCr * kEr}});
+}
+
 TEST(Kinematic, LongitudinalScaleOffsetAndGradeGain) {
   const Eigen::Index n = 2000;
   const Eigen::VectorXd t = time_grid(0.01, n);

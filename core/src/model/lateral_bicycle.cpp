@@ -17,6 +17,7 @@ LateralBicycleModel::LateralBicycleModel(const Constants& constants) {
   if (mass_) mass_ = c.positive("mass", "kg, known vehicle mass");
   imu_x_ = c.optional("imu_x").value_or(0.0);
   min_speed_ = c.positive_or("min_speed", 1.0);
+  gravity_ = c.positive_or("gravity", detail::kStandardGravity);
 }
 
 ParameterInfo LateralBicycleModel::scaled(ParameterInfo p) const {
@@ -35,7 +36,22 @@ std::vector<ParameterInfo> LateralBicycleModel::parameters() const {
 
 std::vector<ChannelNeed> LateralBicycleModel::channels() const {
   return {{"vx", "m/s"},         {"vy", "m/s"},           {"ay", "m/s^2"},
-          {"yaw_rate", "rad/s"}, {"d_yaw_rate", "rad/s^2"}, {"steer", "rad"}};
+          {"yaw_rate", "rad/s"}, {"d_yaw_rate", "rad/s^2"}, {"steer", "rad"},
+          {"roll", "rad", true}, {"az", "m/s^2", true}};
+}
+
+std::function<double(Eigen::Index)> LateralBicycleModel::road_plane_ay(const ChannelSet& set) const {
+  const Eigen::VectorXd& ay = set["ay"];
+  const Eigen::VectorXd* roll = detail::find(set, "roll");
+  if (roll == nullptr) return [&ay](Eigen::Index k) { return ay(k); };
+  // The body-fixed accelerometer turned back to the road plane: y_road = ay cos(roll) - az
+  // sin(roll), with the measured az when present (it reads about +g), else gravity.
+  const Eigen::VectorXd* az = detail::find(set, "az");
+  const double g = gravity_;
+  return [&ay, roll, az, g](Eigen::Index k) {
+    const double vertical = az != nullptr ? (*az)(k) : g;
+    return ay(k) * std::cos((*roll)(k)) - vertical * std::sin((*roll)(k));
+  };
 }
 
 std::function<LateralBicycleModel::Slip(Eigen::Index)> LateralBicycleModel::slip(
@@ -73,6 +89,13 @@ std::vector<RowModel::EffectDefinition> LateralBicycleModel::effect_definitions(
                        {scaled(parameter("steer_offset_force", "N", "C_f times the offset", 0.0))},
                        {}},
                       [](double) { return 1.0; }, false),
+          axle_effect({effect::kSlipOffset,
+                       "constant slip-angle offsets e_f, e_r (steer, vy, yaw-rate offsets at a "
+                       "steady speed): forces C_f e_f, C_r e_r",
+                       {scaled(parameter("front_slip_offset_force", "N", "C_f e_f", 0.0)),
+                        scaled(parameter("rear_slip_offset_force", "N", "C_r e_r", 0.0))},
+                       {}},
+                      [](double) { return 1.0; }, true),
           axle_effect({effect::kTyreSaturation,
                        "Fiala tyre before saturation: F_y = C d - C^2/(3 mu F_z) |d| d",
                        {scaled(parameter("front_tyre_saturation", "N/rad^2", "|d| d coefficient")),
@@ -84,10 +107,9 @@ std::vector<RowModel::EffectDefinition> LateralBicycleModel::effect_definitions(
 RowModel::RowFn LateralBicycleModel::bind(const ChannelSet& set,
                                           const std::vector<std::string>&) const {
   const Eigen::VectorXd& vx = set["vx"];
-  const Eigen::VectorXd& ay = set["ay"];
   const Eigen::VectorXd& dr = set["d_yaw_rate"];
   const double scale = mass_.value_or(1.0);
-  return [=, this, &vx, &ay, &dr, s = slip(set)](Eigen::Index k, std::size_t group, double* w,
+  return [=, this, &vx, &dr, ay = road_plane_ay(set), s = slip(set)](Eigen::Index k, std::size_t group, double* w,
                                                   double& y) {
     if (vx(k) < min_speed_) return false;
     const Slip v = s(k);

@@ -39,6 +39,8 @@ inline constexpr const char* kStribeck = "stribeck_friction";
 inline constexpr const char* kViscous = "viscous_friction";
 inline constexpr const char* kTorqueOffset = "engine_torque_offset";  ///< sensor offset
 inline constexpr const char* kSteerOffset = "steer_offset";          ///< sensor offset
+/// Constant slip-angle offsets on both axles (steer, vy and yaw-rate sensor offsets).
+inline constexpr const char* kSlipOffset = "slip_offset";
 inline constexpr const char* kForceOffset = "hub_force_offset";      ///< sensor offsets
 inline constexpr const char* kDictionaryPrefix = "dict:";
 }  // namespace effect

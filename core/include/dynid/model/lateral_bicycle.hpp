@@ -9,7 +9,14 @@
 //
 // ay is the accelerometer (specific force): M ay is the tyre force whatever the road bank, so
 // no grade/bank term appears; an IMU imu_x ahead of the CG reads ay + imu_x dr/dt, removed.
-// The front longitudinal force term F_xf sin(steer) is neglected (small steer).
+// The front longitudinal force term F_xf sin(steer) is neglected (small steer: measured 0.2 %).
+// Roll: a body-fixed accelerometer on a body rolled by phi reads ay cos(phi) + az sin(phi), i.e.
+// g phi more than the road-plane ay. With a roll gradient of ~0.006 rad per m/s^2 that is ~6 % of
+// ay, all of it a scale error on C_f, C_r and J (found on the reference simulator: +6..8 % with
+// the tyres linear). When the optional channel `roll` (body roll to the road, rad) is present the
+// lateral row uses ay cos(roll) - az sin(roll) (az when present, else gravity): no parameter.
+// The part of the lateral force that accelerates the unsprung masses (they do not roll with the
+// body, so the body IMU misses m_u h d2phi/dt2) is not modelled: about +1 % on this car.
 //
 // Groups "lateral" and "yaw". With the optional constant `mass` (weighed, or identified by the
 // longitudinal model) the parameters are [yaw_inertia, front_cornering_stiffness,
@@ -20,8 +27,13 @@
 //
 // Rows left out: vx < min_speed (slip angles undefined). Constants: a, b (m, CG to front and
 // rear axle); optional mass (kg), imu_x (m, 0), min_speed (m/s, 1).
-// Effects: steer_offset (an offset d0 on the steer sensor: a force C_f d0), tyre_saturation
-// (|d| d terms of a Fiala tyre before saturation, nehaoua §10.3).
+// Effects: steer_offset (an offset d0 on the steer sensor: a force C_f d0), slip_offset
+// (constant slip-angle offsets e_f, e_r on both axles: forces C_f e_f, C_r e_r; at a steady speed
+// the steer, vy and yaw-rate sensor offsets all shift the slip angles by constants, and a few
+// mrad of steer offset against a 0.02 rad slip angle cost -5 % on C_f; it contains steer_offset,
+// enable one of the two), tyre_saturation (|d| d terms of a Fiala tyre before saturation,
+// nehaoua §10.3; a 0.03 rad slip is already 13 % below the linear force).
+// Optional channels: roll, az (see above).
 #include <optional>
 
 #include "dynid/model/constants.hpp"
@@ -49,6 +61,9 @@ class LateralBicycleModel final : public RowModel {
     double cos_steer;
   };
   std::function<Slip(Eigen::Index)> slip(const ChannelSet& channels) const;
+  // The lateral specific force in the road plane: ay itself, or with `roll` present the
+  // accelerometer turned back through the body's roll angle.
+  std::function<double(Eigen::Index)> road_plane_ay(const ChannelSet& channels) const;
   // The parameter as identified: per unit mass when the mass is not known.
   ParameterInfo scaled(ParameterInfo p) const;
   // An effect whose lateral column is front(s) cos(steer) + rear(s) and yaw column
@@ -61,6 +76,7 @@ class LateralBicycleModel final : public RowModel {
   std::optional<double> mass_;
   double imu_x_;
   double min_speed_;
+  double gravity_;
 };
 
 }  // namespace dynid::model
