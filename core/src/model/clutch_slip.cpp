@@ -15,6 +15,23 @@ ClutchSlipModel::ClutchSlipModel(const Constants& constants) {
   if (c.optional("stribeck_speed"))
     stribeck_speed_ = c.positive("stribeck_speed", "rad/s, Stribeck speed v_s");
   min_slip_ = c.positive_or("min_slip_speed", 1e-3);
+  stick_margin_ = c.optional("stick_margin").value_or(0.0);
+  // A negative margin is an error: positive() throws naming the constant.
+  if (stick_margin_ < 0.0) stick_margin_ = c.positive("stick_margin", "s, >= 0");
+}
+
+std::vector<bool> ClutchSlipModel::near_stick(const ChannelSet& set) const {
+  const Eigen::VectorXd& we = set["engine_speed"];
+  const Eigen::VectorXd& wi = set["gearbox_input_speed"];
+  const Eigen::Index n = set.samples();
+  const auto reach = static_cast<Eigen::Index>(std::ceil(stick_margin_ / set.sample_period() - 1e-9));
+  std::vector<bool> out(static_cast<std::size_t>(n), false);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (std::abs(we(k) - wi(k)) >= min_slip_) continue;
+    for (Eigen::Index j = std::max<Eigen::Index>(0, k - reach); j <= std::min(n - 1, k + reach); ++j)
+      out[static_cast<std::size_t>(j)] = true;
+  }
+  return out;
 }
 
 std::vector<ParameterInfo> ClutchSlipModel::parameters() const {
@@ -74,10 +91,10 @@ RowModel::RowFn ClutchSlipModel::bind(const ChannelSet& set,
   const Eigen::VectorXd& te = set["engine_torque"];
   const Eigen::VectorXd& wi = set["gearbox_input_speed"];
   const Eigen::VectorXd& load = set["clutch_clamp_load"];
-  return [&, radius = radius_, min = min_slip_](Eigen::Index k, std::size_t, double* w,
-                                                 double& y) {
+  return [&, radius = radius_, stuck = near_stick(set)](Eigen::Index k, std::size_t, double* w,
+                                                        double& y) {
     const double slip = we(k) - wi(k);
-    if (std::abs(slip) < min) return false;
+    if (stuck[static_cast<std::size_t>(k)]) return false;
     w[0] = dwe(k);
     w[1] = load(k) * radius * detail::sgn(slip);
     y = te(k);

@@ -12,10 +12,17 @@
 // (Gamma_n exp(-(dw/v_s)^2) sgn dw, mu_s - mu_c) complete borsotto's Stribeck model. v_s enters
 // nonlinearly: it is a constant of the model, chosen by StribeckSpeedBank (stribeck_bank.hpp)
 // among candidates by minimum residual (borsotto §8.4).
-// Rows left out: |dw| < min_slip_speed (sgn undefined: the clutch sticks; borsotto's dv).
+// Rows left out: |dw| < min_slip_speed (sgn undefined: the clutch sticks; borsotto's dv), and
+// every row within stick_margin seconds of such a sample (borsotto §8.4: drop rows near clutch
+// state changes). Why: the channels are low-passed forward-backward before the rows are built,
+// so a row a few samples from a lock-up carries the stuck clutch's torque and the kink of the
+// engine speed through the filter window, while its own (filtered) slip still looks large. On
+// the reference simulator those rows took mu_c from 0.159 to 0.093 (min_slip_speed = 3 rad/s,
+// 5 Hz filter); with a margin of about 2 / cut-off they are gone. A larger min_slip_speed does
+// the same only by luck of the slip rate near lock.
 //
 // Constants: clutch_friction_radius (m); optional stribeck_speed (rad/s; without it the
-// stribeck_friction effect is not offered), min_slip_speed (rad/s, 1e-3).
+// stribeck_friction effect is not offered), min_slip_speed (rad/s, 1e-3), stick_margin (s, 0).
 // Effects: viscous_friction, stribeck_friction, engine_torque_offset (ECU torque = true - T0).
 #include <optional>
 
@@ -42,9 +49,13 @@ class ClutchSlipModel final : public RowModel {
   // A column Gamma_n * law(slip).
   EffectDefinition friction_effect(Effect info, std::function<double(double)> law) const;
 
+  // Per sample: within stick_margin of a sample whose |slip| < min_slip_speed.
+  std::vector<bool> near_stick(const ChannelSet& channels) const;
+
   double radius_;
   std::optional<double> stribeck_speed_;
   double min_slip_;
+  double stick_margin_ = 0.0;  // s
 };
 
 }  // namespace dynid::model
