@@ -22,7 +22,8 @@ std::vector<std::pair<std::string, std::string>> make_catalogue() {
                      {"wheel_torque", "N m"},
                      {"brake_pressure", "Pa"},
                      {"road_grade", "rad"},
-                     {"road_bank", "rad"}});
+                     {"road_bank", "rad"},
+                     {"roll", "rad"}});
   for (const char* w : kCorners) {
     c.emplace_back(std::string("susp_travel_") + w, "m");
     c.emplace_back(std::string("susp_force_") + w, "N");

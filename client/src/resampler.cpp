@@ -87,10 +87,12 @@ double Resampler::stale_after(std::size_t channel, const Channel& c) const {
 
 bool Resampler::decided(std::size_t channel, double t) const {
   const Channel& c = channels_[channel];
+  if (!c.samples.empty() && c.samples.back().time >= t) return true;
+  // Verdicts of "missing" only for times the source clock has reached, so that a stream whose
+  // channels are all stale does not run ahead of its own data.
+  if (t > clock_) return false;
   if (clock_ > t + config_.max_latency) return true;
-  if (c.samples.empty()) return false;
-  const double last = c.samples.back().time;
-  return last >= t || clock_ > last + stale_after(channel, c);
+  return !c.samples.empty() && clock_ > c.samples.back().time + stale_after(channel, c);
 }
 
 std::optional<double> Resampler::value_at(const Channel& c, double t) const {

@@ -189,6 +189,14 @@ double gain_term(const Reader& r, const VehicleProfile& p, const toml::node& n, 
   return v;
 }
 
+// "signal" or "signals", whichever the mapping uses, and its node.
+std::string signals_key(const toml::table& t, const std::string& key) {
+  return key + (t.contains("signal") ? ".signal" : ".signals");
+}
+const toml::node* signals_node(const toml::table& t) {
+  return t.contains("signal") ? t.get("signal") : t.get("signals");
+}
+
 LinearConversion input_conversion(const Reader& r, const toml::table& t, const std::string& key,
                                   const ChannelMapping& m, const can::Signal& s, std::string& unit) {
   if (t.contains("factor") || t.contains("offset")) {
@@ -206,15 +214,15 @@ LinearConversion input_conversion(const Reader& r, const toml::table& t, const s
   if (unit.empty()) {
     // DBC files leave counts and states unitless; that is a unit only for a unitless channel.
     if (m.unit == "-") return {};
-    r.fail(key + ".signals", "missing unit: " + what + " has no unit in the DBC and channel '" +
-                                 m.channel + "' needs '" + m.unit + "'; give dbc_unit or factor/offset",
-           t.get("signals") ? t.get("signals") : t.get("signal"));
+    r.fail(signals_key(t, key), "missing unit: " + what + " has no unit in the DBC and channel '" +
+                                    m.channel + "' needs '" + m.unit + "'; give dbc_unit or factor/offset",
+           signals_node(t));
   }
   auto c = conversion(unit, m.unit);
   if (!c)
-    r.fail(key + ".signals", "cannot convert " + what + " from '" + unit + "' to '" + m.unit +
-                                 "' (channel '" + m.channel + "'); give dbc_unit or factor/offset",
-           t.get("signals") ? t.get("signals") : t.get("signal"));
+    r.fail(signals_key(t, key), "cannot convert " + what + " from '" + unit + "' to '" + m.unit +
+                                    "' (channel '" + m.channel + "'); give dbc_unit or factor/offset",
+           signals_node(t));
   return *c;
 }
 
@@ -247,9 +255,9 @@ ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml
   for (const auto& name : signal_names(r, t, key)) {
     auto index = m.dbc_message->signal_index(name);
     if (!index)
-      r.fail(key + ".signals", "unknown DBC signal '" + name + "' in message '" + m.message + "' of " +
-                                   p.dbc_path.filename().string(),
-             t.get("signals") ? t.get("signals") : t.get("signal"));
+      r.fail(signals_key(t, key), "unknown DBC signal '" + name + "' in message '" + m.message + "' of " +
+                                      p.dbc_path.filename().string(),
+             signals_node(t));
     SignalInput in{name, *index, {}, {}};
     in.to_si = input_conversion(r, t, key, m, m.dbc_message->signals[*index], in.dbc_unit);
     m.inputs.push_back(std::move(in));
@@ -281,10 +289,9 @@ void read_channels(const Reader& r, const toml::table& root, VehicleProfile& p) 
   for (std::size_t i = 0; i < a->size(); ++i) {
     const std::string key = "channels[" + std::to_string(i) + "]";
     const toml::table& t = *a->get(i)->as_table();
-    ChannelMapping m = read_channel(r, p, t, key);
-    if (!seen.insert(m.channel).second)
-      r.fail(key + ".name", "duplicate channel '" + m.channel + "'", t.get("name"));
-    p.channels.push_back(std::move(m));
+    if (!seen.insert(r.string(t, "name", key + ".name")).second)
+      r.fail(key + ".name", "duplicate channel '" + *t["name"].value<std::string>() + "'", t.get("name"));
+    p.channels.push_back(read_channel(r, p, t, key));
   }
 }
 

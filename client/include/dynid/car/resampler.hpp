@@ -17,9 +17,10 @@
 //
 // Streaming and latency: the clock is the newest timestamp seen (push or advance_clock, which
 // the pipeline calls for every frame, mapped or not). Row k is emitted, in order, as soon as
-// every channel has decided it: it has a sample at or after t_k, or it is stale for t_k
-// (the clock is past its last sample + G_c, so no future sample can bracket t_k within G_c), or
-// the clock is past t_k + max_latency. So a row is emitted at most max_latency (source clock)
+// every channel has decided it: it has a sample at or after t_k, or the clock has reached t_k and
+// the channel is stale (the clock is past its last sample + max_gap_periods x the longest
+// interval of its window, beyond which the rule above cannot bridge whatever comes next) or the
+// clock is past t_k + max_latency. So a row is emitted at most max_latency (source clock)
 // after its time even if a channel falls silent. finish() emits the rows up to the last time
 // every channel with data has reached, then stops.
 //
@@ -30,6 +31,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <span>
 #include <vector>
@@ -99,7 +101,7 @@ class Resampler {
   RowSink sink_;
   std::vector<Channel> channels_;
   std::optional<double> origin_;
-  double clock_ = 0.0;
+  double clock_ = -std::numeric_limits<double>::infinity();
   std::uint64_t next_row_ = 0;
   std::vector<double> row_;
   ResamplerStats stats_;
