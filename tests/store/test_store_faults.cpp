@@ -188,6 +188,7 @@ TEST(StoreCrash, EveryAcknowledgedChunkSurvivesSigkillMidStream) {
     acknowledged = highest;
 
     Store store(path);
+    EXPECT_EQ(raw_int(path, "SELECT journal_mode = 'wal' FROM pragma_journal_mode"), 1);
     const auto contiguous = store.highest_contiguous(kRun);
     ASSERT_TRUE(contiguous.has_value());
     EXPECT_GE(static_cast<std::int64_t>(*contiguous), acknowledged);

@@ -32,8 +32,10 @@
 //
 // Integrity. On open, PRAGMA quick_check (or integrity_check, or none: StoreOptions) must pass,
 // else CorruptionError naming the file. Every blob carries a CRC-32 that is checked when it
-// is read back (chunks also through decode_chunk): a damaged row is reported as
-// CorruptionError naming the file and its vehicle/run/sequence, never used.
+// is read back (a chunk's is its own checksum, kept in the row and inside the bytes, checked by
+// decode_chunk; the decoded ids, sequence, grid index and row count must match the row too): a
+// damaged row is reported as CorruptionError naming the file and vehicle/run/sequence, never
+// used.
 //
 // Bad input (errors.hpp): an unknown run or vehicle, an announcement that conflicts with the
 // stored one, a chunk that fails ingest::validate_chunk against its announcement, a new chunk
