@@ -45,6 +45,10 @@ Qos state_qos() {
   dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_durability(qos.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
   dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 1);
+  // What a writer keeps for late joiners: also the latest per instance (Cyclone serves them
+  // from this, not from the history QoS).
+  dds_qset_durability_service(qos.get(), 0, DDS_HISTORY_KEEP_LAST, 1, DDS_LENGTH_UNLIMITED,
+                              DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
   // A writer that goes away (server restart) leaves its last states alive in readers.
   dds_qset_writer_data_lifecycle(qos.get(), false);
   return qos;

@@ -20,6 +20,7 @@
 #include "dynid/dds/request.hpp"
 #include "dynid/dds/sample.hpp"
 #include "dynid/ingest/chunk.hpp"
+#include "dynid/error.hpp"
 #include "dynid/ingest/run_announcement.hpp"
 
 namespace dynid::dds {
