@@ -72,6 +72,7 @@ std::vector<CanBinding> can_bindings(const VehicleParameters& vehicle) {
       {"az", "TI_IMU", "VertAccel", 1.0},
       {"vy", "TI_Optical", "VelLat", kKmh},
       {"wheel_torque", "TI_WheelTorque", "DrivenWheelTorque", 1.0},
+      {"roll", "TI_RideHeight", "BodyRoll", kDeg},
   });
   return b;
 }

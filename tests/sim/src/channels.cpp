@@ -48,6 +48,7 @@ std::vector<ChannelInfo> make_catalogue() {
     for (const char* f : {"hub_fx_", "hub_fy_", "hub_fz_"}) c.push_back({std::string(f) + w, "N"});
   for (const char* w : kCornerNames) c.push_back({std::string("tyre_deflection_") + w, "m"});
   for (const char* w : kCornerNames) c.push_back({std::string("tyre_force_z_") + w, "N"});
+  c.push_back({"roll", "rad"});
   return c;
 }
 
@@ -116,6 +117,13 @@ std::vector<double> true_channel_values(const CarModel& model, const State& s,
   }
   out.insert(out.end(), e.tyre_deflection.begin(), e.tyre_deflection.end());
   out.insert(out.end(), e.tyre_load.begin(), e.tyre_load.end());
+  // Body roll to the road as a pair of ride-height lasers per axle sees it: the suspension and
+  // tyre compressions, right minus left, over the track, averaged over the axles (corners
+  // fl, fr, rl, rr; both positive in compression, so positive is right side down).
+  const auto axle_roll = [&](std::size_t left, std::size_t right, double track) {
+    return ((e.travel[right] - e.travel[left]) + (e.tyre_deflection[right] - e.tyre_deflection[left])) / track;
+  };
+  out.push_back(0.5 * (axle_roll(0, 1, v.track_front) + axle_roll(2, 3, v.track_rear)));
   return out;
 }
 

@@ -8,7 +8,8 @@
 // give body rates; `vx` is the mean of the four wheel circumferential speeds; `vy` the lateral
 // speed at the CG in the yaw frame; hub forces are the tyre contact forces in the yaw frame
 // (the rim mass and the hub moments are not modelled); susp_force is the spring-damper-bar force
-// on the body, static part included.
+// on the body, static part included; `roll` is the body's roll angle to the road from the
+// suspension travels and tyre deflections (what ride-height lasers on the body measure).
 #include <cstddef>
 #include <string>
 #include <string_view>
