@@ -64,6 +64,30 @@ TEST(ClutchSlip, ExactRecoveryOfInertiaAndStribeckFriction) {
   for (const Eigen::Index k : rows[0].samples) EXPECT_GE(std::abs(slip(k)), 1e-3);
 }
 
+// A clamp-load sensor reading F0 with the clutch open: the tare's zero, given as the constant
+// clutch_clamp_load_zero, gives the exact recovery back (every friction column uses F - F0).
+TEST(ClutchSlip, ClampLoadZeroFromTheTareIsSubtractedInEveryFrictionColumn) {
+  model::ChannelSet clean = slipping_run(kClio, kEngineInertia);
+  const double f0 = 137.0;
+  model::ChannelSet set(clean.sample_period(), clean.samples());
+  for (const auto& name : clean.names())
+    set.add(name, clean.unit(name),
+            name == "clutch_clamp_load" ? Eigen::VectorXd(clean[name].array() + f0) : clean[name]);
+  const model::Constants constants{{"clutch_friction_radius", kRadius}, {"stribeck_speed", kClio.speed}};
+  model::Constants zeroed = constants;
+  zeroed["clutch_clamp_load_zero"] = f0;
+  const Identified id =
+      identify(*model::make_model("clutch_slip", zeroed), set, {"viscous_friction", "stribeck_friction"});
+  EXPECT_LT(relative_error(id.value("engine_inertia"), kEngineInertia), 1e-6);
+  EXPECT_LT(relative_error(id.value("coulomb_friction"), kClio.coulomb), 1e-6);
+  EXPECT_LT(relative_error(id.value("stribeck_friction"), kClio.stribeck), 1e-6);
+  EXPECT_LT(relative_error(id.value("viscous_friction"), kClio.viscous), 1e-6);
+  // Without it the offset spoils the recovery.
+  const Identified raw =
+      identify(*model::make_model("clutch_slip", constants), set, {"viscous_friction", "stribeck_friction"});
+  EXPECT_GT(relative_error(raw.value("coulomb_friction"), kClio.coulomb), 1e-3);
+}
+
 // A low-passed run smears what happens while the clutch sticks into the rows around it; with
 // stick_margin those rows are left out. Here the torque within 0.1 s of a near-zero slip is
 // spoiled (as a filter would spoil it): with a 0.1 s margin the recovery stays exact.

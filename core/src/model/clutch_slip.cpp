@@ -15,6 +15,7 @@ ClutchSlipModel::ClutchSlipModel(const Constants& constants) {
   if (c.optional("stribeck_speed"))
     stribeck_speed_ = c.positive("stribeck_speed", "rad/s, Stribeck speed v_s");
   min_slip_ = c.positive_or("min_slip_speed", 1e-3);
+  clamp_load_zero_ = c.optional("clutch_clamp_load_zero").value_or(0.0);
   stick_margin_ = c.optional("stick_margin").value_or(0.0);
   // A negative margin is an error: positive() throws naming the constant.
   if (stick_margin_ < 0.0) stick_margin_ = c.positive("stick_margin", "s, >= 0");
@@ -50,12 +51,12 @@ std::vector<ChannelNeed> ClutchSlipModel::channels() const {
 RowModel::EffectDefinition ClutchSlipModel::friction_effect(Effect info,
                                                             std::function<double(double)> law) const {
   return detail::one_column(
-      std::move(info), [law = std::move(law), radius = radius_](const ChannelSet& set) {
+      std::move(info), [law = std::move(law), radius = radius_, zero = clamp_load_zero_](const ChannelSet& set) {
         const Eigen::VectorXd& we = set["engine_speed"];
         const Eigen::VectorXd& wi = set["gearbox_input_speed"];
         const Eigen::VectorXd& load = set["clutch_clamp_load"];
-        return detail::ValueFn([&we, &wi, &load, law, radius](Eigen::Index k) {
-          return load(k) * radius * law(we(k) - wi(k));
+        return detail::ValueFn([&we, &wi, &load, law, radius, zero](Eigen::Index k) {
+          return (load(k) - zero) * radius * law(we(k) - wi(k));
         });
       });
 }
@@ -91,12 +92,12 @@ RowModel::RowFn ClutchSlipModel::bind(const ChannelSet& set,
   const Eigen::VectorXd& te = set["engine_torque"];
   const Eigen::VectorXd& wi = set["gearbox_input_speed"];
   const Eigen::VectorXd& load = set["clutch_clamp_load"];
-  return [&, radius = radius_, stuck = near_stick(set)](Eigen::Index k, std::size_t, double* w,
-                                                        double& y) {
+  return [&, radius = radius_, zero = clamp_load_zero_, stuck = near_stick(set)](Eigen::Index k, std::size_t,
+                                                                                double* w, double& y) {
     const double slip = we(k) - wi(k);
     if (stuck[static_cast<std::size_t>(k)]) return false;
     w[0] = dwe(k);
-    w[1] = load(k) * radius * detail::sgn(slip);
+    w[1] = (load(k) - zero) * radius * detail::sgn(slip);
     y = te(k);
     return true;
   };

@@ -23,6 +23,7 @@ LongitudinalModel::LongitudinalModel(const Constants& constants, Source source) 
   min_speed_ = c.positive_or("min_speed", 1.0);
   brake_threshold_ = c.positive_or("brake_pressure_threshold", 2e4);
   slip_tolerance_ = c.positive_or("clutch_slip_tolerance", 1.0);
+  wheel_torque_zero_ = c.optional("wheel_torque_zero").value_or(0.0);
 }
 
 std::string LongitudinalModel::name() const {
@@ -57,7 +58,7 @@ std::function<LongitudinalModel::Drive(Eigen::Index)> LongitudinalModel::drive(
   const double r = wheel_radius_;
   if (source_ == Source::kWheelTorque) {
     const Eigen::VectorXd& t = set["wheel_torque"];
-    return [&t, r](Eigen::Index k) { return Drive{t(k) / r, 1.0 / r}; };
+    return [&t, r, zero = wheel_torque_zero_](Eigen::Index k) { return Drive{(t(k) - zero) / r, 1.0 / r}; };
   }
   const Eigen::VectorXd& t = set["engine_torque"];
   const Eigen::VectorXd& ratio = set["gear_ratio"];

@@ -22,7 +22,17 @@
 // the same only by luck of the slip rate near lock.
 //
 // Constants: clutch_friction_radius (m); optional stribeck_speed (rad/s; without it the
-// stribeck_friction effect is not offered), min_slip_speed (rad/s, 1e-3), stick_margin (s, 0).
+// stribeck_friction effect is not offered), min_slip_speed (rad/s, 1e-3), stick_margin (s, 0),
+// clutch_clamp_load_zero (N, 0).
+//
+// clutch_clamp_load_zero: what the clamp-load sensor reads with the clutch fully open (zero
+// load), from the run's tare (ingest/zero_calibration.hpp); every friction column uses
+// Gamma_n = (clutch_clamp_load - clutch_clamp_load_zero) R. Why not an offset column: the offset
+// F0 multiplies every friction term (R F0 mu(dw)), so it would take one bilinear column per term;
+// its Coulomb part is a constant torque on a launch (slip always > 0), the same column as
+// engine_torque_offset; and its viscous part R F0 mu_v dw is a column the model does not have,
+// weighing most where the load is small (engagement starts from 0, and the clutch-open rows of
+// a standing start carry F0 alone).
 // Effects: viscous_friction, stribeck_friction, engine_torque_offset (ECU torque = true - T0).
 #include <optional>
 
@@ -56,6 +66,7 @@ class ClutchSlipModel final : public RowModel {
   std::optional<double> stribeck_speed_;
   double min_slip_;
   double stick_margin_ = 0.0;  // s
+  double clamp_load_zero_ = 0.0;  // N
 };
 
 }  // namespace dynid::model

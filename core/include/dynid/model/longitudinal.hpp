@@ -23,7 +23,18 @@
 //
 // Constants: wheel_radius (m), air_density (kg/m^3), driveline_efficiency (engine source,
 // 0 < eta <= 1); optional gravity (9.80665), min_speed (1 m/s), brake_pressure_threshold
-// (2e4 Pa), clutch_slip_tolerance (1 rad/s).
+// (2e4 Pa), clutch_slip_tolerance (1 rad/s), wheel_torque_zero (N m, 0: wheel source).
+//
+// wheel_torque_zero: what the wheel-torque meter reads at zero torque, from the run's tare
+// (ingest/zero_calibration.hpp: standing in neutral or with the clutch open, the driveshafts
+// carry nothing); the model uses T_w = wheel_torque - wheel_torque_zero. Why not an offset
+// column: within a run an offset T0 / r is a constant force, the same column as F_r sgn(vx)
+// (the car never reverses), so no run separates it from rolling resistance; and across runs it
+// differs (a strain-gauge zero drifts from run to run), so the coast-down (no torque: the
+// homogeneous equation that scales SCx against the mass) and the acceleration run disagree on
+// the constant, and least squares pays the mismatch in mass and SCx (reference simulator,
+// 5 N m per run: -1.6 .. +0.8 % on the mass with the seed; -0.4 % on every seed with no
+// offsets).
 // Effects: road_grade, road_grade_accelerometer, linear_drag, brake_drag; engine source also
 // engine_torque_offset and rotating_inertia (engine inertia seen through the gear: per-gear
 // equivalent mass M + eta J_e G^2 / r_w^2).
@@ -62,6 +73,7 @@ class LongitudinalModel final : public RowModel {
   double min_speed_;
   double brake_threshold_;
   double slip_tolerance_;
+  double wheel_torque_zero_ = 0.0;  // N m
 };
 
 }  // namespace dynid::model
