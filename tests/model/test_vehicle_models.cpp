@@ -89,6 +89,17 @@ TEST(Longitudinal, WheelTorqueRecoversOnFlatRoad) {
                    {{"mass", kMass}, {"SCx", kSCx}, {"rolling_resistance", kRolling}});
 }
 
+// A wheel-torque meter reading T0 at zero torque: the tare's zero, given as the constant
+// wheel_torque_zero, gives the exact recovery back.
+TEST(Longitudinal, WheelTorqueZeroFromTheTareIsSubtracted) {
+  LongitudinalRun run = longitudinal_run(0.0);
+  const double t0 = -23.5;
+  run.set.add("wheel_torque", "N m", Eigen::VectorXd(run.force.array() * kRadius + t0));
+  const auto m = model::make_model("longitudinal_wheel",
+                                   {{"wheel_radius", kRadius}, {"air_density", kRho}, {"wheel_torque_zero", t0}});
+  expect_recovered(identify(*m, run.set), {{"mass", kMass}, {"SCx", kSCx}, {"rolling_resistance", kRolling}});
+}
+
 // Lateral bicycle truth (a, b: venture §6.0 Peugeot 406 geometry; stiffnesses: test values).
 constexpr double kA = 1.09, kB = 1.60, kYaw = 2342.0, kCf = 90000.0, kCr = 110000.0,
                  kImuX = -0.4;
@@ -177,6 +188,36 @@ TEST(LateralBicycle, RollChannelRemovesGravityFromTheAccelerometer) {
 
 // Constant slip-angle offsets e_f, e_r on both axles (what steer, vy and yaw-rate sensor
 // offsets give at a steady speed): slip_offset recovers C_f e_f and C_r e_r exactly.
+// The rolling body: the lateral force also accelerates what the IMU does not see roll (or an
+// IMU off the rolling CG reads h d2phi/dt2 too much), and J_xz couples roll into yaw. With the
+// effect roll_acceleration both coefficients and the truth come back exactly.
+TEST(LateralBicycle, RollAccelerationRecoversRollCouplings) {
+  const model::ChannelSet clean = bicycle_run();
+  const Eigen::Index n = clean.samples();
+  const Eigen::VectorXd t = time_grid(clean.sample_period(), n);
+  const Sines roll_rate{0.0, {0.05, 0.02}, {0.7, 1.9}, {0.1, 0.4}};
+  const Eigen::VectorXd p = roll_rate.values(t), dp = roll_rate.derivatives(t);
+  constexpr double kLateral = 85.0, kYawProduct = -45.0;  // kg m, kg m^2
+  model::ChannelSet set(clean.sample_period(), n);
+  for (const auto& name : clean.names())
+    if (name != "ay" && name != "d_yaw_rate") set.add(name, clean.unit(name), clean[name]);
+  // Rows: M (ay - imu_x dr) = F_y + kLateral dp;  0 = J dr - a F_yf + b F_yr + kYawProduct dp.
+  const Eigen::VectorXd dr = clean["d_yaw_rate"] - (kYawProduct / kYaw) * dp;
+  const Eigen::VectorXd ay = clean["ay"] + kImuX * (dr - clean["d_yaw_rate"]) + (kLateral / kMass) * dp;
+  set.add("d_yaw_rate", "rad/s^2", dr);
+  set.add("ay", "m/s^2", ay);
+  set.add("roll_rate", "rad/s", p);
+  set.add("d_roll_rate", "rad/s^2", dp);
+  const auto m =
+      model::make_model("lateral_bicycle", {{"a", kA}, {"b", kB}, {"mass", kMass}, {"imu_x", kImuX}});
+  expect_recovered(identify(*m, set, {"roll_acceleration"}),
+                   {{"yaw_inertia", kYaw},
+                    {"front_cornering_stiffness", kCf},
+                    {"rear_cornering_stiffness", kCr},
+                    {"roll_lateral_moment", kLateral},
+                    {"roll_yaw_product", kYawProduct}});
+}
+
 TEST(LateralBicycle, SlipOffsetRecoversConstantSlipAngleOffsets) {
   const model::ChannelSet clean = bicycle_run();
   const Eigen::Index n = clean.samples();

@@ -101,7 +101,25 @@ std::vector<RowModel::EffectDefinition> LateralBicycleModel::effect_definitions(
                        {scaled(parameter("front_tyre_saturation", "N/rad^2", "|d| d coefficient")),
                         scaled(parameter("rear_tyre_saturation", "N/rad^2", "|d| d coefficient"))},
                        {}},
-                      detail::signed_square, true)};
+                      detail::signed_square, true),
+          roll_acceleration()};
+}
+
+RowModel::EffectDefinition LateralBicycleModel::roll_acceleration() const {
+  EffectDefinition def{{effect::kRollAcceleration,
+                        "roll acceleration of the body: lateral m_r h_r d2phi/dt2 (masses that do not roll "
+                        "with the body, IMU above or below the rolling CG), yaw J_xz d2phi/dt2",
+                        {scaled(parameter("roll_lateral_moment", "kg m", "lateral force per roll acceleration", 0.0)),
+                         scaled(parameter("roll_yaw_product", "kg m^2", "yaw moment per roll acceleration", 0.0))},
+                        {"roll_rate", "d_roll_rate"}},
+                       {}};
+  def.bind = [](const ChannelSet& set) -> ColumnFn {
+    return [&droll = set["d_roll_rate"]](Eigen::Index k, std::size_t g, double* out) {
+      out[g == 0 ? 0 : 1] = droll(k);
+      return true;
+    };
+  };
+  return def;
 }
 
 RowModel::RowFn LateralBicycleModel::bind(const ChannelSet& set,

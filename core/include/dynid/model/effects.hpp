@@ -41,6 +41,8 @@ inline constexpr const char* kTorqueOffset = "engine_torque_offset";  ///< senso
 inline constexpr const char* kSteerOffset = "steer_offset";          ///< sensor offset
 /// Constant slip-angle offsets on both axles (steer, vy and yaw-rate sensor offsets).
 inline constexpr const char* kSlipOffset = "slip_offset";
+/// Body roll acceleration in the lateral and yaw rows (masses not rolling, J_xz).
+inline constexpr const char* kRollAcceleration = "roll_acceleration";
 inline constexpr const char* kForceOffset = "hub_force_offset";      ///< sensor offsets
 inline constexpr const char* kDictionaryPrefix = "dict:";
 }  // namespace effect

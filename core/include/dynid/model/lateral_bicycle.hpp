@@ -32,7 +32,16 @@
 // the steer, vy and yaw-rate sensor offsets all shift the slip angles by constants, and a few
 // mrad of steer offset against a 0.02 rad slip angle cost -5 % on C_f; it contains steer_offset,
 // enable one of the two), tyre_saturation (|d| d terms of a Fiala tyre before saturation,
-// nehaoua §10.3; a 0.03 rad slip is already 13 % below the linear force).
+// nehaoua §10.3; a 0.03 rad slip is already 13 % below the linear force), roll_acceleration
+// (columns d_roll_rate in both rows: roll_lateral_moment, kg m, and roll_yaw_product, kg m^2).
+// Why roll_acceleration: the body rolls about an axis near the ground; the IMU on the body reads
+// the acceleration of its own point, which the roll acceleration moves by h d2phi/dt2, while the
+// unsprung masses (~10 % of the car) do not roll, so M ay misses (or adds) about m_u h d2phi/dt2;
+// and a sprung mass with a product of inertia J_xz couples roll into yaw. Both grow with the
+// square of the frequency: on the reference simulator's sine sweep to 2 Hz (roll gradient 0.006
+// rad per m/s^2, IMU at the sprung CG 0.55 m up) they cost +3..+5 % on C_r and +1..2 % on J
+// (sensors quiet: C_r +4.4 %); with the effect, within 1.5 %. roll_rate is the body gyro; its
+// derivative d_roll_rate is made by the server like any d_ channel.
 // Optional channels: roll, az (see above).
 #include <optional>
 
@@ -70,6 +79,7 @@ class LateralBicycleModel final : public RowModel {
   // -a front(s) cos(steer) + b rear(s), for tyre-force-like terms.
   EffectDefinition axle_effect(Effect info, std::function<double(double)> law,
                                bool rear) const;
+  EffectDefinition roll_acceleration() const;
 
   double a_;
   double b_;
