@@ -1,21 +1,33 @@
-// Realistic accuracy: simulated runs with sensor noise, offsets, CAN quantization and every
-// effect on; preprocessing as the server does it (zero-phase low-pass, central differences);
-// rows from the project's models; incremental QR identification. Each parameter must be within
-// its tolerance of the simulator's truth.
+// Realistic accuracy through the product's data path, as a test engineer's run goes: the
+// simulator drives the test car (sensor noise, offsets, CAN quantization, every effect on) and
+// writes can.log (each message at its DBC cycle time); dynid_car_core replays it with the test
+// car's profile (deploy/profiles/testcar.toml: decode, units, interpolation at the frames'
+// timestamps, gaps) into chunks; ingest::RunProcessor preprocesses them as the server does
+// (streaming zero-phase low-pass, derivatives), builds the model rows and folds them into its
+// weighted accumulators. Runs of one manoeuvre family are merged accumulator by accumulator (the
+// union of their rows), and each parameter must be within its tolerance of the simulator's truth.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <functional>
 #include <memory>
 
+#include <unistd.h>
+
+#include <dynid/car/candump_source.hpp>
+#include <dynid/car/pipeline.hpp>
+#include <dynid/car/replay.hpp>
+#include <dynid/car/vehicle_profile.hpp>
+
+#include "dynid/ingest/run_processor.hpp"
+#include "dynid/ingest/zero_calibration.hpp"
 #include "dynid/ls/equation_groups.hpp"
-#include "dynid/model/clutch_slip.hpp"
-#include "dynid/model/lateral_bicycle.hpp"
-#include "dynid/model/longitudinal.hpp"
-#include "dynid/signal/butterworth.hpp"
-#include "dynid/signal/derivative.hpp"
-#include "dynid/signal/zero_phase_filter.hpp"
+#include "dynid/model/registry.hpp"
+#include "dynid/sim/outputs.hpp"
 #include "sim_test_support.hpp"
 
 namespace dynid::sim {
@@ -23,58 +35,98 @@ namespace {
 
 using SimRun = dynid::sim::Run;
 
-// Zero-phase low-pass cut-off (Hz) of the manoeuvres whose dynamics reach ~2 Hz (sine steer
-// sweep to 2 Hz, throttle variation at 1.3 Hz, launches). A coast-down is a slow decay (time
-// constant ~1 min): its cut-off is 1 Hz, because the regressor d_vx is a differentiated noisy
+// A coast-down is a slow decay (time constant ~1 min): the run is announced with a 1 Hz
+// cut-off instead of the profile's 5 Hz, because the regressor d_vx is a differentiated noisy
 // speed whose noise grows as cut-off^1.5 and, being in a column, biases the mass low
-// (errors in variables; docs/ACCURACY.md).
-constexpr double kCutoffHz = 5.0;
+// (errors in variables; docs/ACCURACY.md). The other manoeuvres reach ~2 Hz: the default rule
+// (0.8 fs / 16 = 5 Hz at 100 Hz) keeps them.
 constexpr double kCoastDownCutoffHz = 1.0;
+constexpr double kDefaultCutoffHz = 5.0;
 
-// Channels the server derives before building rows (docs/CHANNELS.md):
-//  - vx: the mean of the four wheel speeds (each has its own sensor noise, so the mean is
-//    half as noisy as one speed signal, and the ESP's VehSpeed is no better than one);
-//  - roll: body roll angle to the road from the suspension travels and tyre deflections,
-//    roll = ((s_r - s_l) + (d_r - d_l)) / track, averaged over both axles.
-void add_derived(const SimRun& r, model::ChannelSet& set) {
-  const auto& v = r.scenario.car.vehicle;
-  const auto axle_roll = [&](const char* left, const char* right, double track) -> Eigen::VectorXd {
-    const std::string l(left), rr(right);
-    return ((set["susp_travel_" + rr] - set["susp_travel_" + l]) +
-            (set["tyre_deflection_" + rr] - set["tyre_deflection_" + l])) / track;
-  };
-  set.add("roll", "rad", 0.5 * (axle_roll("fl", "fr", v.track_front) + axle_roll("rl", "rr", v.track_rear)));
+// Diagnosis only: DYNID_ACCURACY_OFF="sensor_offsets,quantization" switches simulator effects
+// off (effects.hpp names) to measure what one effect costs, DYNID_ACCURACY_NO_TARE skips the
+// zero calibration; the committed test runs with every effect on and the tare.
+std::string scenario_text(const std::string& file) {
+  std::string text = test::load_scenario_text(file);
+  const char* off = std::getenv("DYNID_ACCURACY_OFF");
+  if (off == nullptr || *off == '\0') return text;
+  text += "\n[effects]\n";
+  std::string names(off);
+  for (std::size_t start = 0; start <= names.size();) {
+    const std::size_t comma = std::min(names.find(',', start), names.size());
+    if (comma > start) text += names.substr(start, comma - start) + " = false\n";
+    start = comma + 1;
+  }
+  return text;
 }
 
-Eigen::VectorXd wheel_mean(const model::ChannelSet& set) {
-  return 0.25 * (set["wheel_speed_fl"] + set["wheel_speed_fr"] + set["wheel_speed_rl"] + set["wheel_speed_rr"]);
+const car::VehicleProfile& testcar_profile() {
+  static const car::VehicleProfile p = car::load_vehicle_profile(DYNID_TESTCAR_PROFILE);
+  return p;
 }
 
-// DYCARO's script_filtre: every channel low-passed forward-backward, derivatives by central
-// differences of the filtered signal. Discrete channels (gear) pass unfiltered.
-model::ChannelSet preprocess(const SimRun& r, const std::vector<std::string>& derivatives,
-                             double cutoff_hz = kCutoffHz) {
-  const auto n = static_cast<Eigen::Index>(r.time.size());
-  const double period = r.time[1] - r.time[0];
-  const auto sos = signal::butterworth_lowpass(4, cutoff_hz, 1.0 / period);
-  model::ChannelSet filtered_set(period, n);
-  for (std::size_t c = 0; c < r.channels.size(); ++c) {
-    Eigen::VectorXd x(n);
-    for (Eigen::Index k = 0; k < n; ++k) x(k) = r.measured[static_cast<std::size_t>(k)][c];
-    const std::string& name = r.channels[c].name;
-    const bool discrete = name == "gear" || name == "gear_ratio";
-    Eigen::VectorXd filtered = discrete ? x : Eigen::VectorXd(signal::zero_phase_filter(sos, x).col(0));
-    filtered_set.add(name, r.channels[c].unit, filtered);
+// The profile's spec of a model (constants merged) with the effects and extra constants the
+// run's manoeuvre calls for.
+ingest::ModelSpec model_spec(const std::string& name, std::vector<std::string> effects,
+                             const model::Constants& extra = {}) {
+  for (const auto& m : testcar_profile().models)
+    if (m.model == name) {
+      ingest::ModelSpec s = m;
+      s.effects = std::move(effects);
+      for (const auto& [k, v] : extra) s.constants[k] = v;
+      return s;
+    }
+  ADD_FAILURE() << "the test car's profile has no model " << name;
+  return {};
+}
+
+// A simulated run's can.log replayed through the car's data path with the test car's profile;
+// every chunk goes to `sink`.
+void replay_run(const SimRun& r, const std::string& run_name, const std::function<void(ingest::Chunk&&)>& sink) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("dynid-accuracy-" + std::to_string(::getpid()) + "-" + run_name);
+  std::filesystem::create_directories(dir);
+  write_can_log(dir / "can.log", r);
+  car::CarPipeline pipeline(testcar_profile(), run_name, sink);
+  car::CandumpSource source(dir / "can.log");
+  const car::ReplayProgress progress = car::replay(source, pipeline);
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(progress.bad, 0U) << run_name;
+  EXPECT_EQ(progress.unknown_id, 0U) << run_name;
+  EXPECT_GT(progress.rows, 0U) << run_name;
+}
+
+// The run's tare (deploy/scenarios/tare.toml, same sensors: same seed) through the same path:
+// the zeros of the wheel-torque meter and the clamp-load sensor.
+ingest::ZeroCalibration tare_for(const SimRun& r) {
+  const SimRun tare = test::run(scenario_text("tare.toml"), r.seed);
+  const std::string name = "tare-" + r.scenario.name + "-" + std::to_string(r.seed);
+  ingest::ZeroCalibration zero(testcar_profile().announcement(name), {"wheel_torque", "clutch_clamp_load"});
+  replay_run(tare, name, [&](ingest::Chunk&& c) { zero.push(c); });
+  if (std::getenv("DYNID_ACCURACY_VERBOSE") != nullptr)
+    for (const auto& [channel, value] : zero.zeros())
+      std::printf("tare %s: zero %.4g, simulated offset %.4g\n", channel.c_str(), value,
+                  r.offsets[channel_index(channel)]);
+  return zero;
+}
+
+// One run through the product: tare, then can.log -> replay with the profile -> chunks ->
+// RunProcessor. Returns the run's accumulators of its one model.
+ls::EquationGroups process(const SimRun& r, const ingest::ModelSpec& spec, double cutoff_hz = 0.0) {
+  const std::string run_name = r.scenario.name + "-" + std::to_string(r.seed);
+  ingest::RunAnnouncement a = testcar_profile().announcement(run_name);
+  a.models = {spec};
+  a.preprocessing.cutoff_hz = cutoff_hz;
+  if (std::getenv("DYNID_ACCURACY_NO_TARE") == nullptr) tare_for(r).apply(a);
+  ingest::RunProcessor processor(a);
+  replay_run(r, run_name, [&](ingest::Chunk&& c) { processor.push(c); });
+  processor.finish();
+  const ls::EquationGroups* g = processor.groups(0);
+  if (g == nullptr) {
+    ADD_FAILURE() << run_name << ": model " << spec.model << " not run: " << processor.estimates()[0].note;
+    return ls::EquationGroups(1, {"none"});
   }
-  model::ChannelSet set(period, n);
-  for (const auto& name : filtered_set.names())
-    set.add(name, filtered_set.unit(name), name == "vx" ? wheel_mean(filtered_set) : filtered_set[name]);
-  add_derived(r, set);
-  for (const auto& name : derivatives) {
-    const std::string unit = set.unit(name) == "m/s" ? "m/s^2" : "rad/s^2";
-    set.add("d_" + name, unit, Eigen::VectorXd(signal::derivative(set[name], period).col(0)));
-  }
-  return set;
+  return *g;
 }
 
 // Seeds: the committed ones, shifted by DYNID_ACCURACY_SEED_SHIFT (e.g. 100) to check that the
@@ -97,14 +149,14 @@ struct Result {
   }
 };
 
-Result identify(const model::Model& m, const std::vector<model::ChannelSet>& runs,
-                const std::vector<std::string>& effects) {
+// Merges the runs' accumulators group by group and solves DYCARO's weighted problem.
+Result identify(const ingest::ModelSpec& spec, const std::vector<ls::EquationGroups>& runs) {
   Result out;
-  for (const auto& p : m.parameters_with(effects)) out.names.push_back(p.name);
-  ls::EquationGroups groups(static_cast<Eigen::Index>(out.names.size()), m.groups());
-  for (const auto& set : runs)
-    for (const auto& g : m.rows(set, effects))
-      if (g.W.rows() > 0) groups.fold(groups.index_of(g.group), g.W, g.y);
+  const auto m = model::make_model(spec.model, spec.constants);
+  for (const auto& p : m->parameters_with(spec.effects)) out.names.push_back(p.name);
+  ls::EquationGroups groups(static_cast<Eigen::Index>(out.names.size()), m->groups());
+  for (const auto& run : runs)
+    for (std::size_t g = 0; g < groups.size(); ++g) groups.group(g).merge(run.group(run.index_of(groups.name(g))));
   out.estimate = groups.estimate().estimate;
   return out;
 }
@@ -130,58 +182,51 @@ void report_and_check(const std::string& model, const std::vector<Check>& checks
 }
 
 TEST(SimAccuracy, LateralBicycle) {
-  const SimRun r = test::run(test::load_scenario_text("sine_steer.toml"), seed(11));
-  const auto set = preprocess(r, {"yaw_rate"});
-  const auto& v = r.scenario.car.vehicle;
-  model::LateralBicycleModel m({{"a", v.cg_to_front_axle}, {"b", v.cg_to_rear_axle}, {"mass", v.mass},
-                                {"imu_x", v.imu_position[0]}});
-  // The roll channel turns the accelerometer back to the road plane (it reads g sin(roll), ~6 %
-  // of ay on this car); tyre_saturation is the Fiala |d| d term (13 % of the front force at the
-  // peak slip of this run); slip_offset takes the steer, vy and yaw-rate sensor offsets.
-  const Result res = identify(m, {set}, {"tyre_saturation", "slip_offset"});
+  const SimRun r = test::run(scenario_text("sine_steer.toml"), seed(11));
+  // The roll channel (ride-height lasers) turns the accelerometer back to the road plane (it
+  // reads g sin(roll), ~6 % of ay on this car); tyre_saturation is the Fiala |d| d term (13 % of
+  // the front force at the peak slip of this run); slip_offset takes the steer, vy and yaw-rate
+  // sensor offsets; roll_acceleration the unsprung masses that do not roll with the body (the
+  // IMU at the sprung CG reads h d2phi/dt2 for the whole car: +4 % on C_r at the 2 Hz end of
+  // the sweep).
+  const auto spec = model_spec("lateral_bicycle", {"tyre_saturation", "slip_offset", "roll_acceleration"});
+  const Result res = identify(spec, {process(r, spec)});
   const auto truth = [&](const std::string& k) { return test::truth_value(r, k); };
   report_and_check("lateral_bicycle",
-                   {{"yaw_inertia", truth("vehicle.yaw_inertia"), res.value(m.parameters()[0].name),
-                     res.std_dev(m.parameters()[0].name), 0.03},
+                   {{"yaw_inertia", truth("vehicle.yaw_inertia"), res.value("yaw_inertia"),
+                     res.std_dev("yaw_inertia"), 0.03},
                     {"front_cornering_stiffness", truth("vehicle.cornering_stiffness_front"),
-                     res.value(m.parameters()[1].name), res.std_dev(m.parameters()[1].name), 0.05},
+                     res.value("front_cornering_stiffness"), res.std_dev("front_cornering_stiffness"), 0.05},
                     {"rear_cornering_stiffness", truth("vehicle.cornering_stiffness_rear"),
-                     res.value(m.parameters()[2].name), res.std_dev(m.parameters()[2].name), 0.05}});
+                     res.value("rear_cornering_stiffness"), res.std_dev("rear_cornering_stiffness"), 0.05}});
 }
 
 TEST(SimAccuracy, LongitudinalFromWheelTorque) {
-  const SimRun acc = test::run(test::load_scenario_text("acceleration.toml"), seed(12));
-  const SimRun coast = test::run(test::load_scenario_text("coast_down.toml"), seed(13));
-  const auto& v = acc.scenario.car.vehicle;
-  model::LongitudinalModel m({{"wheel_radius", v.wheel_radius}, {"air_density", v.air_density}},
-                             model::LongitudinalModel::Source::kWheelTorque);
-  const Result res = identify(m, {preprocess(acc, {"vx"}), preprocess(coast, {"vx"}, kCoastDownCutoffHz)},
-                              {"brake_drag"});
-  const auto& p = m.parameters();
+  const SimRun acc = test::run(scenario_text("acceleration.toml"), seed(12));
+  const SimRun coast = test::run(scenario_text("coast_down.toml"), seed(13));
+  const auto spec = model_spec("longitudinal_wheel", {"brake_drag"});
+  const Result res = identify(spec, {process(acc, spec), process(coast, spec, kCoastDownCutoffHz)});
   // The wheel torque accelerates the car and the spin inertia of its four wheels: the mass this
   // row identifies is M + 4 J_w / r^2 (truth: longitudinal_equivalent_mass).
   report_and_check("longitudinal",
                    {{"mass (equivalent)", test::truth_value(acc, "vehicle.longitudinal_equivalent_mass"),
-                     res.value(p[0].name), res.std_dev(p[0].name), 0.01},
-                    {"scx", test::truth_value(acc, "vehicle.scx"), res.value(p[1].name), res.std_dev(p[1].name), 0.05}});
+                     res.value("mass"), res.std_dev("mass"), 0.01},
+                    {"scx", test::truth_value(acc, "vehicle.scx"), res.value("SCx"), res.std_dev("SCx"), 0.05}});
 }
 
 TEST(SimAccuracy, ClutchSlip) {
-  const SimRun r = test::run(test::load_scenario_text("launch.toml"), seed(14));
-  const auto& d = r.scenario.car.driveline;
-  model::ClutchSlipModel m({{"clutch_friction_radius", d.clutch_radius}, {"stribeck_speed", d.clutch_stribeck_speed},
-                       // Noisy speed sensors (0.5 rad/s): a stuck clutch reads a slip of up to
-                       // ~2 rad/s; and no row whose low-pass window (about 2 / cut-off) reaches
-                       // a stuck sample, where the friction law does not hold.
-                       {"min_slip_speed", 2.0}, {"stick_margin", 2.0 / kCutoffHz}});
-  const Result res = identify(m, {preprocess(r, {"engine_speed"})},
-                              {"viscous_friction", "stribeck_friction", "engine_torque_offset"});
-  const auto& p = m.parameters();
+  const SimRun r = test::run(scenario_text("launch.toml"), seed(14));
+  // Noisy speed sensors (0.5 rad/s): a stuck clutch reads a slip of up to ~2 rad/s; and no row
+  // whose low-pass window (about 2 / cut-off) reaches a stuck sample, where the friction law
+  // does not hold.
+  const auto spec = model_spec("clutch_slip", {"viscous_friction", "stribeck_friction", "engine_torque_offset"},
+                               {{"min_slip_speed", 2.0}, {"stick_margin", 2.0 / kDefaultCutoffHz}});
+  const Result res = identify(spec, {process(r, spec)});
   report_and_check("clutch_slip",
-                   {{"engine_inertia", test::truth_value(r, "driveline.engine_inertia"), res.value(p[0].name),
-                     res.std_dev(p[0].name), 0.05},
-                    {"coulomb_friction", test::truth_value(r, "driveline.clutch.mu_coulomb"), res.value(p[1].name),
-                     res.std_dev(p[1].name), 0.02}});
+                   {{"engine_inertia", test::truth_value(r, "driveline.engine_inertia"), res.value("engine_inertia"),
+                     res.std_dev("engine_inertia"), 0.05},
+                    {"coulomb_friction", test::truth_value(r, "driveline.clutch.mu_coulomb"),
+                     res.value("coulomb_friction"), res.std_dev("coulomb_friction"), 0.02}});
 }
 
 }  // namespace
