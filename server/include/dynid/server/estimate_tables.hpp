@@ -1,0 +1,33 @@
+#pragma once
+// From a run's (or a pool's) model estimates to the tables that are published and printed.
+//
+// tables_of(): one EstimateTable per model that has an estimate, optionally only `model`;
+// models without one (not run, no row yet) are listed in `notes` with the reason. Group rows
+// and residual RMS come from each group's own statistics (unweighted).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dynid/dds/estimate_table.hpp"
+#include "dynid/ingest/run_processor.hpp"
+
+namespace dynid::server {
+
+struct EstimateTables {
+  std::vector<dds::EstimateTable> tables;
+  std::vector<std::string> notes;  ///< "<model>: <why there is no estimate>"
+};
+
+dds::EstimateTable table_of(const std::string& vehicle, const std::string& source,
+                            const std::string& model,
+                            const std::vector<model::ParameterInfo>& parameters,
+                            const ls::WeightedEstimate& estimate);
+
+EstimateTables tables_of(const std::string& vehicle, const std::string& source,
+                         const std::vector<ingest::ModelEstimate>& estimates,
+                         const std::optional<std::string>& model = std::nullopt);
+
+/// Text (the tables, then the notes) or JSON ({"tables":[...],"notes":[...]}).
+std::string render(const EstimateTables& tables, bool json);
+
+}  // namespace dynid::server

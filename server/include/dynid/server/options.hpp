@@ -1,0 +1,53 @@
+#pragma once
+// ServerOptions: everything dynid-server is started with, and their command-line form (CLI11).
+//
+//   --store PATH             SQLite store (created if absent)                 required
+//   --cyclone-config CONFIG  Cyclone configuration: a file path, a file:// URI or an XML
+//                            fragment list as in CYCLONEDDS_URI. Required: the server never
+//                            runs on Cyclone's default configuration (it picks the machine's
+//                            default interface).
+//   --domain D               DDS domain id (0)
+//   --threads T              folding workers (0: one per core)
+//   --checkpoint-every N     save a run's accumulators every N folded chunks (50)
+//   --publish-interval-ms M  publish a run's estimates at most every M ms (250)
+//   --shard K/N              own the vehicles whose hash mod N == K (0/1: all)
+//   --reorder-window W       chunks stored ahead of a gap (store.hpp) (256)
+//   --log-level L            trace, debug, info, warn, error (info)
+//
+// parse_options() throws InputError with CLI11's message on a bad command line, and returns
+// std::nullopt after printing --help.
+#include <dds/dds.h>
+
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "dynid/server/shard.hpp"
+#include "dynid/store/store.hpp"
+
+namespace dynid::server {
+
+struct ServerOptions {
+  std::string store_path;
+  std::string cyclone_config;  ///< as given; see cyclone_config_uri()
+  dds_domainid_t domain = 0;
+  unsigned threads = 0;
+  std::uint64_t checkpoint_every = 50;
+  std::chrono::milliseconds publish_interval{250};
+  Shard shard;
+  store::StoreOptions store;
+  std::string log_level = "info";
+
+  /// The worker count actually used (threads, or the number of cores, at least 1).
+  unsigned worker_count() const;
+};
+
+/// What Participant expects: a value starting with "file://" or "<" is used as it is
+/// (URIs and XML fragments, comma-separated); anything else is a path to a file. Throws
+/// InputError for an empty value and DdsError for a path that does not exist.
+std::string cyclone_config_uri(const std::string& value);
+
+std::optional<ServerOptions> parse_options(int argc, const char* const* argv);
+
+}  // namespace dynid::server

@@ -1,0 +1,43 @@
+#pragma once
+// ParsedRequest: an engineer's request (dds::Request) checked against the request kinds the
+// server knows, before any work is queued.
+//
+//   kind        arguments (* required, + repeatable)           reply
+//   vehicles    format                                          the vehicles of this shard
+//   runs        vehicle*, format                                runs with ledger marks
+//   estimate    vehicle*, run, model, format                    estimate tables (latest run)
+//   pooled      vehicle*, run*+, model, format                  merged accumulators' estimate
+//   close       vehicle*, run*, format                          final tables; run closed
+//   reprocess   vehicle*, run*, model*, effects, format         replay into a fresh processor
+//   base        vehicle*, run*, model*, format                  base-parameter report
+//   status      format                                          the server's counters
+// format is "text" (default) or "json"; effects is a comma-separated list.
+//
+// parse_request() throws InputError naming the request ("request alice@host/42#7") and the
+// problem: an unknown kind, an unknown, missing, repeated or empty argument, a bad format.
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dynid/dds/request.hpp"
+
+namespace dynid::server {
+
+struct ParsedRequest {
+  std::string kind;
+  std::map<std::string, std::vector<std::string>> arguments;
+
+  std::optional<std::string> optional(const std::string& name) const;
+  /// The value of a required argument (parse_request checked it is there).
+  const std::string& required(const std::string& name) const;
+  std::vector<std::string> all(const std::string& name) const;
+  bool json() const { return optional("format") == std::optional<std::string>("json"); }
+};
+
+ParsedRequest parse_request(const dds::Request& request);
+
+/// "a,b,,c" -> {"a", "b", "c"}.
+std::vector<std::string> split_list(const std::string& text);
+
+}  // namespace dynid::server

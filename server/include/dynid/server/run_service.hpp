@@ -1,0 +1,126 @@
+#pragma once
+// RunService: the runs of the vehicles pinned to one worker, and everything done to them:
+// the chunk path (DESIGN.md, "Storage"), restart, throttled estimate publication, and the
+// run-level requests. One per worker; only that worker's thread calls it, so it needs no lock
+// of its own (the store is shared through SharedStore).
+//
+// Chunk path, per chunk (receive_chunk):
+//   validate_chunk against the run's announcement -> store_chunk (durable: fsync'd)
+//   -> publish the ChunkAck (highest contiguous stored, recent rejections with reasons)
+//   -> fold every stored contiguous chunk not yet folded, in sequence order (a chunk stored
+//      ahead of a gap is folded when the gap closes) -> mark them folded in the ledger
+//   -> every `checkpoint_every` folded chunks: save the RunProcessor's checkpoint
+//   -> the run's estimates are published at most every `publish_interval` (publish_due).
+// A chunk is acknowledged only once store_chunk returned: never before it is durable. A
+// rejected chunk (unknown run, invalid, conflicting, too far ahead, closed run) is counted,
+// listed in the ack with its reason, and changes no state. A store failure acknowledges
+// nothing (the car resends).
+//
+// Restart (resume): the latest checkpoint is restored (a damaged one is reported and the run
+// rebuilt from #0), the stored chunks after it are replayed, and the ledger's folded mark
+// moves forward with them, so nothing is folded twice. Open runs are resumed at start; closed
+// runs are loaded (and finished) the first time a request needs them.
+//
+// Should a stored chunk be refused by the processor (a model rejects its rows), the run stops
+// folding ("halted", with the reason, logged and in the ack); its chunks stay in the store for
+// a reprocess.
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dynid/dds/chunk_receipt.hpp"
+#include "dynid/dds/participant.hpp"
+#include "dynid/ingest/run_processor.hpp"
+#include "dynid/server/counters.hpp"
+#include "dynid/server/estimate_tables.hpp"
+#include "dynid/server/options.hpp"
+#include "dynid/server/shared_store.hpp"
+#include "dynid/server/vehicle_outputs.hpp"
+
+namespace dynid::server {
+
+/// A request names something that does not exist (reply status NOT_FOUND).
+class NotFound : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+/// What all workers share.
+struct ServerContext {
+  const ServerOptions& options;
+  SharedStore& store;
+  ServerCounters& counters;
+  const dds::Participant& participant;
+  RevisionClock& revisions;
+};
+
+/// The sequence a rejection of the announcement itself carries in a ChunkAck.
+inline constexpr std::uint64_t kAnnouncementSequence = ~std::uint64_t{0};
+
+class RunService {
+ public:
+  explicit RunService(ServerContext& context) : context_(context) {}
+
+  void announce(const ingest::RunAnnouncement& announcement);
+  void receive_chunk(const ingest::Chunk& chunk);
+  /// A chunk sample that could not even be read (from_wire failed): reported to its sender
+  /// when its vehicle and run ids are readable.
+  void reject_unreadable(const std::string& vehicle, const std::string& run,
+                         std::uint64_t sequence, const std::string& reason);
+  void resume(const store::RunKey& key);
+  /// Publishes the estimates of runs that changed and whose interval has passed.
+  void publish_due(std::chrono::steady_clock::time_point now);
+
+  // Run-level requests. InputError/NotFound name what is wrong.
+  EstimateTables estimate(const std::string& vehicle, const std::optional<std::string>& run,
+                          const std::optional<std::string>& model);
+  EstimateTables pooled(const std::string& vehicle, const std::vector<std::string>& runs,
+                        const std::optional<std::string>& model);
+  EstimateTables close(const std::string& vehicle, const std::string& run);
+  EstimateTables reprocess(const std::string& vehicle, const std::string& run,
+                           const std::string& model, const std::vector<std::string>& effects);
+  std::string base_report(const std::string& vehicle, const std::string& run,
+                          const std::string& model, bool json);
+  std::string list_runs(const std::string& vehicle, bool json);
+
+ private:
+  struct RunState {
+    explicit RunState(ingest::RunProcessor p) : processor(std::move(p)) {}
+    ingest::RunProcessor processor;
+    std::int64_t contiguous = -1;
+    std::uint64_t since_checkpoint = 0;
+    std::deque<dds::ChunkRejection> rejections;
+    std::string halted;
+    bool dirty = false;
+    std::chrono::steady_clock::time_point last_published{};
+  };
+
+  RunState* find(const store::RunKey& key);
+  RunState& load(const store::RunKey& key);  // NotFound for an unknown run
+  RunState& load_from_store(const store::RunKey& key);
+  ingest::RunProcessor restore_processor(const store::RunKey& key,
+                                         const ingest::RunAnnouncement& announcement);
+  void reject(const store::RunKey& key, RunState* run, std::uint64_t sequence,
+              const std::string& reason);
+  void publish_ack(const store::RunKey& key, const RunState* run,
+                   const std::vector<dds::ChunkRejection>& extra = {});
+  bool store_and_ack(const store::RunKey& key, RunState& run, const ingest::Chunk& chunk);
+  void fold_ready(const store::RunKey& key, RunState& run, const ingest::Chunk* in_hand);
+  std::vector<ingest::Chunk> read_chunks(const store::RunKey& key, std::uint64_t from,
+                                         std::uint64_t to);
+  void checkpoint(const store::RunKey& key, RunState& run);
+  void publish(const store::RunKey& key, RunState& run);
+  void record_history(const store::RunKey& key, const EstimateTables& tables);
+  std::string latest_run(const std::string& vehicle);
+
+  ServerContext& context_;
+  std::map<store::RunKey, std::unique_ptr<RunState>> runs_;
+  VehicleOutputs outputs_;
+};
+
+}  // namespace dynid::server

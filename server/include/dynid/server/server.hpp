@@ -1,0 +1,47 @@
+#pragma once
+// Server: dynid-server in one object, so tests can run it in-process as well as through the
+// executable (src/main.cpp).
+//
+// Threads: one dispatcher (run()) waits on a waitset over the RunAnnouncement, Chunk and
+// Request readers (all vehicles' partitions, "vehicle/*"), converts each sample (from_wire)
+// and posts it to the worker its vehicle is pinned to (WorkerPool), announcements before
+// chunks in every round, so a run's announcement is handled before the chunks that follow it.
+// Workers store, acknowledge, fold and publish (RunService); requests run on the worker of the
+// vehicle they name (fleet-wide ones on worker 0) and are answered on the Reply topic.
+// A repeated request (same client and correlation id: the client resends when it hears
+// nothing) is answered again from a cache of recent replies, not executed twice.
+//
+// Contract:
+// - The constructor opens the store, joins the domain with options.cyclone_config (required,
+//   never Cyclone's default), starts the workers and queues the resumption of every open run
+//   of this shard. StoreError/CorruptionError/DdsError/InputError on failure.
+// - run() dispatches until stop(); stop() may be called from any thread (not from a signal
+//   handler: main.cpp waits for signals with sigwait). After run() returns, the destructor
+//   lets the workers finish what is queued.
+// - Bad input never ends the server: a malformed sample or request is rejected, counted
+//   (counters()), logged, and changes no state.
+#include <memory>
+
+#include "dynid/server/counters.hpp"
+#include "dynid/server/options.hpp"
+
+namespace dynid::server {
+
+class Server {
+ public:
+  explicit Server(ServerOptions options);
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+  ~Server();
+
+  void run();
+  void stop();
+  CounterSnapshot counters() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dynid::server

@@ -1,0 +1,87 @@
+#include "dynid/report/estimate_report.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "dynid/report/json.hpp"
+
+namespace dynid::report {
+
+namespace {
+
+// "-" where the data cannot identify a value (NaN); 6 significant digits otherwise.
+std::string cell(double value) {
+  if (std::isnan(value)) return "-";
+  return fmt::format("{:.6g}", value);
+}
+
+std::string parameter_line(const dds::ParameterEntry& p) {
+  std::string line = fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {:<10}", p.name, p.unit,
+                                 cell(p.value), cell(p.standard_deviation),
+                                 cell(p.relative_std_percent), status_name(p.status));
+  if (!p.relation.empty()) line += "  = " + p.relation;
+  return line + "\n";
+}
+
+std::string parameter_json(const dds::ParameterEntry& p) {
+  return fmt::format(
+      "{{\"name\":{},\"unit\":{},\"value\":{},\"std\":{},\"relative_std_percent\":{},"
+      "\"status\":{},\"relation\":{}}}",
+      json_string(p.name), json_string(p.unit), json_number(p.value),
+      json_number(p.standard_deviation), json_number(p.relative_std_percent),
+      json_string(status_name(p.status)), json_string(p.relation));
+}
+
+}  // namespace
+
+const char* status_name(ls::ParameterStatus status) {
+  switch (status) {
+    case ls::ParameterStatus::kIdentified: return "identified";
+    case ls::ParameterStatus::kRegrouped: return "regrouped";
+    case ls::ParameterStatus::kDependent: return "dependent";
+    case ls::ParameterStatus::kEliminated: return "eliminated";
+  }
+  return "unknown";
+}
+
+std::string format_estimate_text(const dds::EstimateTable& t) {
+  std::string out = fmt::format("{} / {}  (source {}, revision {})\n", t.vehicle, t.model,
+                                t.source, t.revision);
+  out += fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {:<10}\n", "parameter", "unit", "value",
+                     "std", "rel.std%", "status");
+  for (const auto& p : t.parameters) out += parameter_line(p);
+  out += fmt::format("  rows {}  sigma {}  cond {}  residual RMS {}  relative residual {}\n",
+                     t.rows, cell(t.sigma), cell(t.condition_number), cell(t.residual_rms),
+                     cell(t.relative_residual_norm));
+  for (const auto& g : t.groups)
+    out += fmt::format("  group {:<28} rows {:>8}  residual RMS {}\n", g.group, g.rows,
+                       cell(g.residual_rms));
+  return out;
+}
+
+std::string estimate_json(const dds::EstimateTable& t) {
+  std::string parameters;
+  for (const auto& p : t.parameters) parameters += (parameters.empty() ? "" : ",") + parameter_json(p);
+  std::string groups;
+  for (const auto& g : t.groups)
+    groups += (groups.empty() ? "" : ",") +
+              fmt::format("{{\"group\":{},\"rows\":{},\"residual_rms\":{}}}", json_string(g.group),
+                          g.rows, json_number(g.residual_rms));
+  return fmt::format(
+      "{{\"vehicle\":{},\"model\":{},\"source\":{},\"revision\":{},\"parameters\":[{}],"
+      "\"rows\":{},\"effective_rows\":{},\"sigma\":{},\"condition_number\":{},"
+      "\"residual_rms\":{},\"relative_residual_norm\":{},\"groups\":[{}]}}",
+      json_string(t.vehicle), json_string(t.model), json_string(t.source), t.revision, parameters,
+      t.rows, json_number(t.effective_rows), json_number(t.sigma),
+      json_number(t.condition_number), json_number(t.residual_rms),
+      json_number(t.relative_residual_norm), groups);
+}
+
+std::string estimates_json(const std::vector<dds::EstimateTable>& tables) {
+  std::string out = "[";
+  for (std::size_t k = 0; k < tables.size(); ++k) out += (k ? "," : "") + estimate_json(tables[k]);
+  return out + "]";
+}
+
+}  // namespace dynid::report

@@ -1,0 +1,143 @@
+// Server::Impl: the dispatcher's steps, from DDS samples to worker tasks (server.hpp).
+#include <spdlog/spdlog.h>
+
+#include <cstring>
+
+#include "dynid/dds/conversions.hpp"
+#include "server_impl.hpp"
+
+namespace dynid::server {
+
+namespace {
+
+constexpr std::size_t kTakePerRound = 64;
+
+// An id field of a sample that failed from_wire, if it is still a terminated string.
+std::optional<std::string> readable_id(const char (&field)[sizeof(dynid_wire_Id)]) {
+  const std::size_t length = strnlen(field, sizeof field);
+  if (length == 0 || length == sizeof field) return std::nullopt;
+  return std::string(field, length);
+}
+
+dds::Reply reply_to(const dds::Request& request, dds::ReplyStatus status, std::string error) {
+  return {request.client, request.correlation_id, status, std::move(error), "text/plain", {}};
+}
+
+}  // namespace
+
+void Server::Impl::dispatch_round() {
+  dispatch_announcements();  // first: a run's announcement before its chunks
+  dispatch_chunks();
+  dispatch_requests();
+}
+
+void Server::Impl::dispatch_announcements() {
+  for (auto& sample : announcements.take(kTakePerRound)) {
+    ingest::RunAnnouncement announcement;
+    try {
+      announcement = dds::from_wire(sample.data);
+    } catch (const InputError& e) {
+      counters.add(&CounterSnapshot::rejected_announcements);
+      spdlog::warn("announcement rejected: {}", e.what());
+      continue;
+    }
+    if (!options.shard.owns(announcement.vehicle)) {
+      counters.add(&CounterSnapshot::not_owned);
+      continue;
+    }
+    const std::size_t worker = pool.worker_of(announcement.vehicle);
+    pool.post(worker, [this, worker, a = std::move(announcement)] { services[worker]->announce(a); });
+  }
+}
+
+void Server::Impl::dispatch_chunks() {
+  for (auto& sample : chunks.take(kTakePerRound)) dispatch_chunk(sample.data);
+}
+
+void Server::Impl::dispatch_chunk(const dynid_wire_Chunk& sample) {
+  std::shared_ptr<ingest::Chunk> chunk;
+  std::string error;
+  try {
+    chunk = std::make_shared<ingest::Chunk>(dds::from_wire(sample));
+  } catch (const InputError& e) {
+    error = e.what();
+  }
+  const auto vehicle = chunk ? std::optional(chunk->vehicle) : readable_id(sample.vehicle);
+  const auto run = chunk ? std::optional(chunk->run) : readable_id(sample.run);
+  if (vehicle && !options.shard.owns(*vehicle)) {
+    counters.add(&CounterSnapshot::not_owned);
+    return;
+  }
+  if (!vehicle || !run) {  // nobody to tell: count and log only
+    counters.add(&CounterSnapshot::chunks_rejected);
+    spdlog::warn("chunk rejected (sender unknown): {}", error);
+    return;
+  }
+  const std::size_t worker = pool.worker_of(*vehicle);
+  RunService* service = services[worker].get();
+  if (chunk) {
+    pool.post(worker, [service, chunk] { service->receive_chunk(*chunk); });
+  } else {
+    pool.post(worker, [service, v = *vehicle, r = *run, s = sample.sequence_number, error] {
+      service->reject_unreadable(v, r, s, error);
+    });
+  }
+}
+
+void Server::Impl::dispatch_requests() {
+  for (auto& sample : requests.take(kTakePerRound)) {
+    counters.add(&CounterSnapshot::requests);
+    try {
+      accept_request(dds::from_wire(sample.data));
+    } catch (const InputError& e) {
+      counters.add(&CounterSnapshot::requests_rejected);
+      spdlog::warn("request rejected: {}", e.what());
+      if (const auto client = readable_id(sample.data.client))
+        send({*client, sample.data.correlation_id, dds::ReplyStatus::kBadRequest, e.what(),
+              "text/plain", {}});
+    }
+  }
+}
+
+// Parses, routes to a shard and a worker, executes there and replies.
+void Server::Impl::accept_request(const dds::Request& request) {
+  ParsedRequest parsed;
+  try {
+    parsed = parse_request(request);
+  } catch (const InputError& e) {
+    counters.add(&CounterSnapshot::requests_rejected);
+    spdlog::warn("{}", e.what());
+    return send(reply_to(request, dds::ReplyStatus::kBadRequest, e.what()));
+  }
+  const auto vehicle = parsed.optional("vehicle");
+  if (vehicle ? !options.shard.owns(*vehicle) : !options.shard.answers_fleet_requests())
+    return;  // another shard's to answer
+  const ReplyCache::Key key{request.client, request.correlation_id};
+  std::optional<dds::Reply> cached;
+  if (!reply_cache.begin(key, cached)) {
+    if (cached) send(*cached);  // the client did not hear the first one
+    return;
+  }
+  const std::size_t worker = vehicle ? pool.worker_of(*vehicle) : 0;
+  pool.post(worker, [this, worker, parsed, request, key] {
+    dds::Reply reply;
+    try {
+      reply = execute(parsed, *services[worker]);
+    } catch (const NotFound& e) {
+      counters.add(&CounterSnapshot::requests_rejected);
+      reply = reply_to(request, dds::ReplyStatus::kNotFound, e.what());
+    } catch (const InputError& e) {
+      counters.add(&CounterSnapshot::requests_rejected);
+      reply = reply_to(request, dds::ReplyStatus::kBadRequest, e.what());
+    } catch (const std::exception& e) {
+      spdlog::error("request {}#{} failed: {}", request.client, request.correlation_id, e.what());
+      reply = reply_to(request, dds::ReplyStatus::kFailed, e.what());
+    }
+    reply.client = request.client;
+    reply.correlation_id = request.correlation_id;
+    reply_cache.finish(key, reply);
+    send(reply);
+  });
+}
+
+}  // namespace dynid::server

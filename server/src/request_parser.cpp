@@ -1,0 +1,93 @@
+#include "dynid/server/request_parser.hpp"
+
+#include <set>
+
+#include "dynid/error.hpp"
+
+namespace dynid::server {
+
+namespace {
+
+struct KindSpec {
+  std::set<std::string> required;
+  std::set<std::string> optional;
+  std::set<std::string> repeatable;
+};
+
+const std::map<std::string, KindSpec>& kinds() {
+  static const std::map<std::string, KindSpec> specs{
+      {"vehicles", {{}, {"format"}, {}}},
+      {"runs", {{"vehicle"}, {"format"}, {}}},
+      {"estimate", {{"vehicle"}, {"run", "model", "format"}, {}}},
+      {"pooled", {{"vehicle", "run"}, {"model", "format"}, {"run"}}},
+      {"close", {{"vehicle", "run"}, {"format"}, {}}},
+      {"reprocess", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},
+      {"base", {{"vehicle", "run", "model"}, {"format"}, {}}},
+      {"status", {{}, {"format"}, {}}},
+  };
+  return specs;
+}
+
+std::string known_kinds() {
+  std::string list;
+  for (const auto& [name, spec] : kinds()) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
+}  // namespace
+
+std::optional<std::string> ParsedRequest::optional(const std::string& name) const {
+  const auto it = arguments.find(name);
+  if (it == arguments.end() || it->second.empty()) return std::nullopt;
+  return it->second.front();
+}
+
+const std::string& ParsedRequest::required(const std::string& name) const {
+  return arguments.at(name).front();
+}
+
+std::vector<std::string> ParsedRequest::all(const std::string& name) const {
+  const auto it = arguments.find(name);
+  return it == arguments.end() ? std::vector<std::string>{} : it->second;
+}
+
+ParsedRequest parse_request(const dds::Request& request) {
+  const std::string where =
+      "request " + request.client + "#" + std::to_string(request.correlation_id);
+  const auto spec = kinds().find(request.kind);
+  if (spec == kinds().end())
+    throw InputError(where + ": unknown kind '" + request.kind + "' (known: " + known_kinds() + ")");
+  ParsedRequest parsed{request.kind, {}};
+  for (const auto& argument : request.arguments) {
+    const auto& s = spec->second;
+    if (!s.required.count(argument.name) && !s.optional.count(argument.name))
+      throw InputError(where + ": '" + request.kind + "' takes no argument '" + argument.name + "'");
+    if (argument.value.empty())
+      throw InputError(where + ": argument '" + argument.name + "' is empty");
+    auto& values = parsed.arguments[argument.name];
+    if (!values.empty() && !s.repeatable.count(argument.name))
+      throw InputError(where + ": argument '" + argument.name + "' given twice");
+    values.push_back(argument.value);
+  }
+  for (const auto& name : spec->second.required)
+    if (!parsed.arguments.count(name))
+      throw InputError(where + ": '" + request.kind + "' needs argument '" + name + "'");
+  if (const auto format = parsed.optional("format"); format && *format != "text" && *format != "json")
+    throw InputError(where + ": format '" + *format + "' is neither text nor json");
+  return parsed;
+}
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const auto comma = text.find(',', start);
+    const auto item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (!item.empty()) items.push_back(item);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return items;
+}
+
+}  // namespace dynid::server

@@ -1,0 +1,284 @@
+// RunService: the chunk path, restart and publication (contract in run_service.hpp).
+#include "dynid/server/run_service.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "dynid/dds/conversions.hpp"
+#include "dynid/report/estimate_report.hpp"
+
+namespace dynid::server {
+
+namespace {
+
+constexpr std::size_t kMaxRejectionsKept = 64;  // = dynid_wire_kMaxRejections
+constexpr std::uint64_t kReplayBatch = 16;      // chunks read from the store per lock
+
+std::string label(const store::RunKey& key) { return key.vehicle + "/" + key.run; }
+
+std::int64_t as_mark(const std::optional<std::uint64_t>& sequence) {
+  return sequence ? static_cast<std::int64_t>(*sequence) : -1;
+}
+
+}  // namespace
+
+// ---- runs in memory ------------------------------------------------------------------
+
+RunService::RunState* RunService::find(const store::RunKey& key) {
+  const auto it = runs_.find(key);
+  return it == runs_.end() ? nullptr : it->second.get();
+}
+
+RunService::RunState& RunService::load(const store::RunKey& key) {
+  if (RunState* run = find(key)) return *run;
+  const bool known = context_.store.with([&](store::Store& s) {
+    const auto vehicles = s.list_vehicles();
+    if (std::find(vehicles.begin(), vehicles.end(), key.vehicle) == vehicles.end()) return false;
+    for (const auto& info : s.list_runs(key.vehicle))
+      if (info.run == key.run) return true;
+    return false;
+  });
+  if (!known) throw NotFound("run " + label(key) + ": unknown run (never announced)");
+  return load_from_store(key);
+}
+
+ingest::RunProcessor RunService::restore_processor(const store::RunKey& key,
+                                                   const ingest::RunAnnouncement& announcement) {
+  try {
+    const auto checkpoint =
+        context_.store.with([&](store::Store& s) { return s.latest_checkpoint(key); });
+    if (checkpoint)
+      return ingest::RunProcessor::restore(announcement, checkpoint->state,
+                                           context_.options.store.limits);
+  } catch (const std::exception& e) {  // damaged: the chunks are the truth, replay from #0
+    spdlog::error("run {}: checkpoint unusable, replaying from #0: {}", label(key), e.what());
+  }
+  return ingest::RunProcessor(announcement, context_.options.store.limits);
+}
+
+RunService::RunState& RunService::load_from_store(const store::RunKey& key) {
+  const auto [announcement, closed, contiguous] = context_.store.with([&](store::Store& s) {
+    bool is_closed = false;
+    for (const auto& info : s.list_runs(key.vehicle))
+      if (info.run == key.run) is_closed = info.closed;
+    return std::make_tuple(s.announcement(key), is_closed, as_mark(s.highest_contiguous(key)));
+  });
+  auto state = std::make_unique<RunState>(restore_processor(key, announcement));
+  state->contiguous = contiguous;
+  RunState& run = *runs_.emplace(key, std::move(state)).first->second;
+  const std::uint64_t from = run.processor.next_sequence();
+  fold_ready(key, run, nullptr);
+  if (closed && !run.processor.finished()) run.processor.finish();
+  spdlog::info("run {}: resumed at #{} ({} stored contiguously{})", label(key), from,
+               run.contiguous + 1, closed ? ", closed" : "");
+  run.dirty = true;
+  return run;
+}
+
+void RunService::resume(const store::RunKey& key) {
+  try {
+    load(key);
+  } catch (const std::exception& e) {
+    spdlog::error("run {}: cannot resume: {}", label(key), e.what());
+  }
+}
+
+// ---- announcements -----------------------------------------------------------------
+
+void RunService::announce(const ingest::RunAnnouncement& announcement) {
+  const store::RunKey key{announcement.vehicle, announcement.run};
+  try {
+    // The processor validates the models too (unknown model, bad constant, wrong unit), so a
+    // run that could never be processed is refused before anything is stored.
+    ingest::RunProcessor processor(announcement, context_.options.store.limits);
+    const auto added = context_.store.with([&](store::Store& s) { return s.add_run(announcement); });
+    context_.counters.add(&CounterSnapshot::announcements);
+    if (find(key)) return;  // announced again (transient-local, a car restart): nothing new
+    if (added == store::AddRunResult::already_known) {
+      load_from_store(key);
+    } else {
+      runs_.emplace(key, std::make_unique<RunState>(std::move(processor)));
+      spdlog::info("run {}: announced ({} channels at {} Hz, {} models)", label(key),
+                   announcement.channels.size(), announcement.sample_rate_hz,
+                   announcement.models.size());
+    }
+    publish_ack(key, find(key));
+  } catch (const InputError& e) {
+    context_.counters.add(&CounterSnapshot::rejected_announcements);
+    spdlog::warn("announcement {} rejected: {}", label(key), e.what());
+    publish_ack(key, find(key), {{kAnnouncementSequence, std::string("announcement rejected: ") + e.what()}});
+  }
+}
+
+// ---- chunks ----------------------------------------------------------------------------
+
+void RunService::reject(const store::RunKey& key, RunState* run, std::uint64_t sequence,
+                        const std::string& reason) {
+  context_.counters.add(&CounterSnapshot::chunks_rejected);
+  spdlog::warn("chunk {}#{} rejected: {}", label(key), sequence, reason);
+  if (!run) {  // unknown run: nothing is kept for it, the ack carries this one reason
+    publish_ack(key, nullptr, {{sequence, reason}});
+    return;
+  }
+  run->rejections.push_back({sequence, reason});
+  if (run->rejections.size() > kMaxRejectionsKept) run->rejections.pop_front();
+  publish_ack(key, run);
+}
+
+void RunService::reject_unreadable(const std::string& vehicle, const std::string& run,
+                                   std::uint64_t sequence, const std::string& reason) {
+  const store::RunKey key{vehicle, run};
+  reject(key, find(key), sequence, reason);
+}
+
+void RunService::receive_chunk(const ingest::Chunk& chunk) {
+  const store::RunKey key{chunk.vehicle, chunk.run};
+  RunState* run = find(key);
+  if (!run) {
+    try {
+      run = &load(key);  // a run announced before a restart, or never announced
+    } catch (const NotFound&) {
+      return reject(key, nullptr, chunk.sequence, "unknown run " + label(key) + " (never announced)");
+    }
+  }
+  try {
+    ingest::validate_chunk(chunk, run->processor.announcement(), context_.options.store.limits);
+  } catch (const InputError& e) {
+    return reject(key, run, chunk.sequence, e.what());
+  }
+  if (store_and_ack(key, *run, chunk)) fold_ready(key, *run, &chunk);
+}
+
+// Stores the chunk durably, then acknowledges; false when nothing new was stored.
+bool RunService::store_and_ack(const store::RunKey& key, RunState& run,
+                               const ingest::Chunk& chunk) {
+  store::StoreChunkResult result;
+  try {
+    result = context_.store.with([&](store::Store& s) { return s.store_chunk(chunk); });
+  } catch (const InputError& e) {  // e.g. the run is closed
+    reject(key, &run, chunk.sequence, e.what());
+    return false;
+  } catch (const store::StoreError& e) {  // nothing stored: acknowledge nothing
+    context_.counters.add(&CounterSnapshot::store_errors);
+    spdlog::error("chunk {}#{} not stored: {}", label(key), chunk.sequence, e.what());
+    return false;
+  }
+  run.contiguous = as_mark(result.contiguous_through);
+  switch (result.status) {
+    case store::ChunkStatus::stored:
+      context_.counters.add(&CounterSnapshot::chunks_stored);
+      publish_ack(key, &run);
+      return true;
+    case store::ChunkStatus::duplicate:
+      context_.counters.add(&CounterSnapshot::chunks_duplicate);
+      publish_ack(key, &run);  // the first ack may have been lost
+      return false;
+    case store::ChunkStatus::conflict:
+    case store::ChunkStatus::beyond_window:
+      reject(key, &run, chunk.sequence, result.reason);
+      return false;
+  }
+  return false;
+}
+
+std::vector<ingest::Chunk> RunService::read_chunks(const store::RunKey& key, std::uint64_t from,
+                                                   std::uint64_t to) {
+  return context_.store.with([&](store::Store& s) {
+    std::vector<ingest::Chunk> chunks;
+    auto stream = s.chunks(key, from, to);
+    while (auto chunk = stream.next()) chunks.push_back(std::move(*chunk));
+    return chunks;
+  });
+}
+
+// Folds next_sequence()..contiguous in order: the chunk in hand when it is the next one,
+// otherwise what the store holds (replay after a restart, chunks that were stored ahead).
+void RunService::fold_ready(const store::RunKey& key, RunState& run, const ingest::Chunk* in_hand) {
+  if (!run.halted.empty() || run.processor.finished()) return;
+  const std::uint64_t first = run.processor.next_sequence();
+  while (run.contiguous >= 0 && run.processor.next_sequence() <= static_cast<std::uint64_t>(run.contiguous)) {
+    const std::uint64_t next = run.processor.next_sequence();
+    std::vector<ingest::Chunk> batch;
+    if (in_hand && in_hand->sequence == next) {
+      batch.push_back(*in_hand);
+    } else {
+      batch = read_chunks(key, next, std::min<std::uint64_t>(next + kReplayBatch - 1, static_cast<std::uint64_t>(run.contiguous)));
+      context_.counters.add(&CounterSnapshot::chunks_replayed, batch.size());
+    }
+    for (const auto& chunk : batch) {
+      try {
+        run.processor.push(chunk);
+      } catch (const InputError& e) {
+        run.halted = std::string("folding halted: ") + e.what();
+        spdlog::error("run {}: {}", label(key), run.halted);
+        run.rejections.push_back({chunk.sequence, run.halted});
+        break;
+      }
+      context_.counters.add(&CounterSnapshot::chunks_folded);
+      run.dirty = true;
+      if (++run.since_checkpoint >= context_.options.checkpoint_every) checkpoint(key, run);
+    }
+    if (!run.halted.empty()) break;
+  }
+  const std::uint64_t after = run.processor.next_sequence();
+  if (after > first)
+    context_.store.with([&](store::Store& s) { s.mark_folded(key, after - 1); });
+}
+
+void RunService::checkpoint(const store::RunKey& key, RunState& run) {
+  const std::uint64_t through = run.processor.next_sequence() - 1;
+  const std::string state = run.processor.checkpoint();
+  context_.store.with([&](store::Store& s) { s.save_checkpoint(key, through, state); });
+  run.since_checkpoint = 0;
+  context_.counters.add(&CounterSnapshot::checkpoints);
+  record_history(key, tables_of(key.vehicle, key.run, run.processor.estimates()));
+}
+
+// ---- publication -------------------------------------------------------------------------
+
+void RunService::publish_ack(const store::RunKey& key, const RunState* run,
+                             const std::vector<dds::ChunkRejection>& extra) {
+  dds::ChunkReceipt receipt{key.vehicle, key.run, run ? run->contiguous : -1, {}};
+  if (run) receipt.rejections.assign(run->rejections.begin(), run->rejections.end());
+  receipt.rejections.insert(receipt.rejections.end(), extra.begin(), extra.end());
+  try {
+    auto& writers = outputs_.writers(context_.participant, key.vehicle);
+    writers.ack.write(to_wire(receipt).data);
+  } catch (const std::exception& e) {  // an id no partition can carry: the log is all we have
+    spdlog::warn("no acknowledgement for {}: {}", label(key), e.what());
+  }
+}
+
+void RunService::publish(const store::RunKey& key, RunState& run) {
+  run.dirty = false;
+  run.last_published = std::chrono::steady_clock::now();
+  auto tables = tables_of(key.vehicle, key.run, run.processor.estimates());
+  auto& writers = outputs_.writers(context_.participant, key.vehicle);
+  for (auto& table : tables.tables) {
+    table.revision = context_.revisions.next();
+    writers.estimate.write(to_wire(table).data);
+    context_.counters.add(&CounterSnapshot::estimates_published);
+  }
+}
+
+void RunService::publish_due(std::chrono::steady_clock::time_point now) {
+  for (auto& [key, run] : runs_) {
+    if (!run->dirty || now - run->last_published < context_.options.publish_interval) continue;
+    try {
+      publish(key, *run);
+    } catch (const std::exception& e) {
+      spdlog::error("run {}: estimates not published: {}", label(key), e.what());
+    }
+  }
+}
+
+void RunService::record_history(const store::RunKey& key, const EstimateTables& tables) {
+  const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                       std::chrono::system_clock::now().time_since_epoch())
+                       .count();
+  context_.store.with([&](store::Store& s) {
+    for (const auto& table : tables.tables)
+      s.record_estimate({key.vehicle, table.model, key.run, now, report::estimate_json(table)});
+  });
+}
+
+}  // namespace dynid::server

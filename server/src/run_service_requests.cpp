@@ -1,0 +1,197 @@
+// RunService: the run-level requests (estimate, pooled, close, reprocess, base, runs).
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <set>
+
+#include "dynid/report/json.hpp"
+#include "dynid/server/run_service.hpp"
+
+namespace dynid::server {
+
+namespace {
+
+using report::json_number;
+using report::json_string;
+
+std::string join(const std::vector<std::string>& items, const std::string& separator) {
+  std::string out;
+  for (const auto& item : items) out += (out.empty() ? "" : separator) + item;
+  return out;
+}
+
+std::vector<std::string> names_of(const std::vector<model::ParameterInfo>& parameters) {
+  std::vector<std::string> names;
+  for (const auto& p : parameters) names.push_back(p.name);
+  return names;
+}
+
+std::vector<std::string> group_names(const ls::EquationGroups& groups) {
+  std::vector<std::string> names;
+  for (std::size_t g = 0; g < groups.size(); ++g) names.push_back(groups.name(g));
+  return names;
+}
+
+// The index of `model` among a processor's models, or npos.
+std::size_t model_index(const std::vector<ingest::ModelEstimate>& estimates,
+                        const std::string& model) {
+  for (std::size_t m = 0; m < estimates.size(); ++m)
+    if (estimates[m].model == model) return m;
+  return std::string::npos;
+}
+
+std::string optional_mark(const std::optional<std::uint64_t>& mark) {
+  return mark ? std::to_string(*mark) : std::string("-");
+}
+
+}  // namespace
+
+std::string RunService::latest_run(const std::string& vehicle) {
+  const auto runs = context_.store.with([&](store::Store& s) {
+    const auto vehicles = s.list_vehicles();
+    if (std::find(vehicles.begin(), vehicles.end(), vehicle) == vehicles.end())
+      throw NotFound("vehicle " + vehicle + ": unknown vehicle");
+    return s.list_runs(vehicle);
+  });
+  if (runs.empty()) throw NotFound("vehicle " + vehicle + ": no run yet");
+  return runs.back().run;
+}
+
+EstimateTables RunService::estimate(const std::string& vehicle,
+                                    const std::optional<std::string>& run,
+                                    const std::optional<std::string>& model) {
+  const store::RunKey key{vehicle, run ? *run : latest_run(vehicle)};
+  const RunState& state = load(key);
+  auto tables = tables_of(vehicle, key.run, state.processor.estimates(), model);
+  if (model && tables.tables.empty() && tables.notes.empty())
+    throw NotFound("run " + vehicle + "/" + key.run + " has no model " + *model);
+  if (!state.halted.empty()) tables.notes.push_back(key.run + ": " + state.halted);
+  return tables;
+}
+
+EstimateTables RunService::pooled(const std::string& vehicle, const std::vector<std::string>& runs,
+                                  const std::optional<std::string>& model) {
+  if (runs.empty()) throw InputError("pooled: name at least one run");
+  if (std::set<std::string>(runs.begin(), runs.end()).size() != runs.size())
+    throw InputError("pooled: a run is named twice (" + join(runs, ", ") + ")");
+  std::vector<const ingest::RunProcessor*> processors;
+  for (const auto& run : runs) processors.push_back(&load({vehicle, run}).processor);
+  const auto first = processors.front()->estimates();
+  EstimateTables out;
+  const std::string source = "pool:" + join(runs, "+");
+  for (std::size_t m = 0; m < first.size(); ++m) {
+    if (model && first[m].model != *model) continue;
+    const ls::EquationGroups* base = processors.front()->groups(m);
+    if (!base) {
+      out.notes.push_back(first[m].model + ": not run in " + runs.front());
+      continue;
+    }
+    ls::EquationGroups pool(static_cast<Eigen::Index>(first[m].parameters.size()), group_names(*base));
+    for (std::size_t r = 0; r < processors.size(); ++r) {
+      const auto estimates = processors[r]->estimates();
+      const std::size_t index = model_index(estimates, first[m].model);
+      const ls::EquationGroups* groups =
+          index == std::string::npos ? nullptr : processors[r]->groups(index);
+      if (!groups) throw InputError("pooled: model " + first[m].model + " is not run in " + runs[r]);
+      if (names_of(estimates[index].parameters) != names_of(first[m].parameters) ||
+          group_names(*groups) != group_names(*base))
+        throw InputError("pooled: runs " + runs.front() + " and " + runs[r] + " configure model " +
+                         first[m].model + " differently (parameters, effects or groups)");
+      for (std::size_t g = 0; g < groups->size(); ++g) pool.group(g).merge(groups->group(g));
+    }
+    try {
+      out.tables.push_back(table_of(vehicle, source, first[m].model, first[m].parameters, pool.estimate()));
+    } catch (const InputError& e) {
+      out.notes.push_back(first[m].model + ": " + e.what());
+    }
+  }
+  if (model && out.tables.empty() && out.notes.empty())
+    throw NotFound("pooled: run " + runs.front() + " has no model " + *model);
+  return out;
+}
+
+EstimateTables RunService::close(const std::string& vehicle, const std::string& run) {
+  const store::RunKey key{vehicle, run};
+  RunState& state = load(key);
+  if (!state.processor.finished()) state.processor.finish();  // folds the held-back samples
+  context_.store.with([&](store::Store& s) { s.close_run(key); });
+  publish(key, state);
+  auto tables = tables_of(vehicle, run, state.processor.estimates());
+  record_history(key, tables);
+  spdlog::info("run {}/{}: closed", vehicle, run);
+  return tables;
+}
+
+EstimateTables RunService::reprocess(const std::string& vehicle, const std::string& run,
+                                     const std::string& model,
+                                     const std::vector<std::string>& effects) {
+  const store::RunKey key{vehicle, run};
+  const RunState& state = load(key);
+  ingest::RunAnnouncement announcement = state.processor.announcement();
+  ingest::ModelSpec spec{model, {}, effects};
+  for (const auto& announced : announcement.models)
+    if (announced.model == model) spec.constants = announced.constants;  // the profile's
+  announcement.models = {spec};
+  ingest::RunProcessor processor(announcement, context_.options.store.limits);
+  for (std::uint64_t next = 0; state.contiguous >= 0 &&
+                               next <= static_cast<std::uint64_t>(state.contiguous);) {
+    const auto to = std::min<std::uint64_t>(next + 15, static_cast<std::uint64_t>(state.contiguous));
+    for (const auto& chunk : read_chunks(key, next, to)) processor.push(chunk);
+    next = to + 1;
+  }
+  if (state.processor.finished()) processor.finish();
+  return tables_of(vehicle, "reprocess:" + run, processor.estimates());
+}
+
+std::string RunService::base_report(const std::string& vehicle, const std::string& run,
+                                    const std::string& model, bool json) {
+  const RunState& state = load({vehicle, run});
+  const auto estimates = state.processor.estimates();
+  const std::size_t m = model_index(estimates, model);
+  if (m == std::string::npos) throw NotFound("run " + vehicle + "/" + run + " has no model " + model);
+  if (!estimates[m].estimate)
+    throw NotFound("model " + model + " of " + vehicle + "/" + run + ": no estimate (" + estimates[m].note + ")");
+  const auto& s = estimates[m].estimate->estimate.structure;
+  const auto names = names_of(estimates[m].parameters);
+  std::vector<std::string> entries;
+  std::string text = fmt::format("{}/{} {}: {} base parameters of {} (tau {:.3g})\n", vehicle, run,
+                                 model, s.rank(), names.size(), s.tolerance);
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    const auto index = static_cast<Eigen::Index>(j);
+    std::string relation;
+    if (s.status[j] == ls::ParameterStatus::kRegrouped) {
+      const auto k = std::find(s.base.begin(), s.base.end(), index) - s.base.begin();
+      relation = s.relation(k, names);
+    }
+    const char* status = ls::to_string(s.status[j]);
+    text += fmt::format("  {:<24} {:<11} {}\n", names[j], status, relation.empty() ? "" : "= " + relation);
+    entries.push_back(fmt::format("{{\"name\":{},\"status\":{},\"relation\":{}}}", json_string(names[j]),
+                                  json_string(status), json_string(relation)));
+  }
+  if (!json) return text;
+  return fmt::format("{{\"vehicle\":{},\"run\":{},\"model\":{},\"rank\":{},\"tolerance\":{},\"parameters\":[{}]}}",
+                     json_string(vehicle), json_string(run), json_string(model), s.rank(),
+                     json_number(s.tolerance), join(entries, ","));
+}
+
+std::string RunService::list_runs(const std::string& vehicle, bool json) {
+  latest_run(vehicle);  // NotFound for an unknown vehicle or one without runs
+  const auto runs = context_.store.with([&](store::Store& s) { return s.list_runs(vehicle); });
+  std::string text = fmt::format("{:<24} {:<7} {:>10} {:>10} {:>8}\n", "run", "state", "stored", "folded", "chunks");
+  std::vector<std::string> entries;
+  for (const auto& r : runs) {
+    const RunState* loaded = find({vehicle, r.run});
+    const std::string halted = loaded ? loaded->halted : std::string();
+    text += fmt::format("{:<24} {:<7} {:>10} {:>10} {:>8}{}\n", r.run, r.closed ? "closed" : "open",
+                        optional_mark(r.contiguous_through), optional_mark(r.folded_through),
+                        r.chunks_stored, halted.empty() ? "" : "  " + halted);
+    entries.push_back(fmt::format(
+        "{{\"run\":{},\"closed\":{},\"contiguous_through\":{},\"folded_through\":{},"
+        "\"chunks_stored\":{},\"halted\":{}}}",
+        json_string(r.run), r.closed, r.contiguous_through ? std::to_string(*r.contiguous_through) : "null",
+        r.folded_through ? std::to_string(*r.folded_through) : "null", r.chunks_stored, json_string(halted)));
+  }
+  return json ? "[" + join(entries, ",") + "]" : text;
+}
+
+}  // namespace dynid::server

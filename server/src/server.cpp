@@ -1,0 +1,168 @@
+// Server: construction, the dispatch loop's frame, and request execution (server.hpp).
+#include "dynid/server/server.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "dynid/dds/conversions.hpp"
+#include "dynid/dds/topics.hpp"
+#include "dynid/report/json.hpp"
+#include "server_impl.hpp"
+
+namespace dynid::server {
+
+namespace {
+
+std::vector<std::unique_ptr<RunService>> make_services(ServerContext& context, unsigned count) {
+  std::vector<std::unique_ptr<RunService>> services;
+  for (unsigned k = 0; k < count; ++k) services.push_back(std::make_unique<RunService>(context));
+  return services;
+}
+
+// Workers wake at least this often to publish estimates whose interval has passed.
+std::chrono::milliseconds tick_period(const ServerOptions& options) {
+  return std::clamp(options.publish_interval / 2, std::chrono::milliseconds(5),
+                    std::chrono::milliseconds(100));
+}
+
+}  // namespace
+
+Server::Impl::Impl(ServerOptions opts)
+    : options(std::move(opts)),
+      store(options.store_path, options.store),
+      participant({options.domain, cyclone_config_uri(options.cyclone_config)}),
+      announcements(participant, {dds::kAllVehiclesPartition}),
+      chunks(participant, {dds::kAllVehiclesPartition}),
+      requests(participant, {}),
+      replies(participant, {}),
+      services(make_services(context, options.worker_count())),
+      pool(options.worker_count(), 256, tick_period(options),
+           [this](std::size_t worker) {
+             services[worker]->publish_due(std::chrono::steady_clock::now());
+           }),
+      waitset(dds::check(dds_create_waitset(participant.handle()), "dds_create_waitset")),
+      stop_guard(dds::check(dds_create_guardcondition(participant.handle()),
+                            "dds_create_guardcondition")) {
+  for (const dds_entity_t reader : {announcements.handle(), chunks.handle(), requests.handle()}) {
+    conditions.emplace_back(dds::check(dds_create_readcondition(reader, DDS_ANY_STATE),
+                                       "dds_create_readcondition"));
+    dds::check(dds_waitset_attach(waitset.get(), conditions.back().get(), 0), "dds_waitset_attach");
+  }
+  dds::check(dds_waitset_attach(waitset.get(), stop_guard.get(), 0), "dds_waitset_attach");
+  resume_open_runs();
+  spdlog::info("dynid-server: store {}, domain {}, {} workers, shard {}, checkpoint every {}",
+               options.store_path, options.domain, pool.size(), options.shard.to_string(),
+               options.checkpoint_every);
+}
+
+Server::Impl::~Impl() {
+  pool.stop();  // finish what is queued while the services and writers still exist
+  spdlog::info("dynid-server stopped; counters {}", counters.snapshot().to_json());
+}
+
+void Server::Impl::resume_open_runs() {
+  const auto open = store.with([&](store::Store& s) {
+    std::vector<store::RunKey> keys;
+    for (const auto& vehicle : s.list_vehicles()) {
+      if (!options.shard.owns(vehicle)) continue;
+      for (const auto& run : s.list_runs(vehicle))
+        if (!run.closed) keys.push_back({vehicle, run.run});
+    }
+    return keys;
+  });
+  for (const auto& key : open) {
+    const std::size_t worker = pool.worker_of(key.vehicle);
+    pool.post(worker, [this, key, worker] { services[worker]->resume(key); });
+  }
+  if (!open.empty()) spdlog::info("resuming {} open runs", open.size());
+}
+
+Server::Server(ServerOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+Server::~Server() = default;
+
+void Server::run() {
+  while (!impl_->stopping.load()) {
+    dds_waitset_wait(impl_->waitset.get(), nullptr, 0, DDS_MSECS(500));
+    if (impl_->stopping.load()) break;
+    try {
+      impl_->dispatch_round();
+    } catch (const std::exception& e) {  // a DDS failure while taking: log, go on
+      spdlog::error("dispatcher: {}", e.what());
+    }
+  }
+}
+
+void Server::stop() {
+  impl_->stopping.store(true);
+  dds_set_guardcondition(impl_->stop_guard.get(), true);
+}
+
+CounterSnapshot Server::counters() const { return impl_->counters.snapshot(); }
+
+// ---- requests ----------------------------------------------------------------------------
+
+std::string Server::Impl::fleet_reply(const ParsedRequest& request) {
+  if (request.kind == "status") return counters.snapshot().to_json();
+  auto vehicles = store.with([](store::Store& s) { return s.list_vehicles(); });
+  std::erase_if(vehicles, [&](const std::string& v) { return !options.shard.owns(v); });
+  std::string out;
+  for (const auto& v : vehicles)
+    out += request.json() ? (out.empty() ? "" : ",") + report::json_string(v) : v + "\n";
+  return request.json() ? "[" + out + "]" : out;
+}
+
+dds::Reply Server::Impl::execute(const ParsedRequest& r, RunService& service) {
+  const auto format = r.json() ? "application/json" : "text/plain";
+  if (r.kind == "vehicles" || r.kind == "status")
+    return {{}, 0, dds::ReplyStatus::kOk, {}, r.kind == "status" ? "application/json" : format,
+            fleet_reply(r)};
+  const std::string& vehicle = r.required("vehicle");
+  std::string payload;
+  if (r.kind == "runs") {
+    payload = service.list_runs(vehicle, r.json());
+  } else if (r.kind == "estimate") {
+    payload = render(service.estimate(vehicle, r.optional("run"), r.optional("model")), r.json());
+  } else if (r.kind == "pooled") {
+    payload = render(service.pooled(vehicle, r.all("run"), r.optional("model")), r.json());
+  } else if (r.kind == "close") {
+    payload = render(service.close(vehicle, r.required("run")), r.json());
+  } else if (r.kind == "reprocess") {
+    payload = render(service.reprocess(vehicle, r.required("run"), r.required("model"),
+                                       split_list(r.optional("effects").value_or(""))),
+                     r.json());
+  } else if (r.kind == "base") {
+    payload = service.base_report(vehicle, r.required("run"), r.required("model"), r.json());
+  }
+  return {{}, 0, dds::ReplyStatus::kOk, {}, format, payload};
+}
+
+void Server::Impl::send(const dds::Reply& reply) {
+  std::lock_guard lock(reply_mutex);
+  try {
+    replies.write(to_wire(reply).data);
+  } catch (const std::exception& e) {
+    spdlog::error("reply to {}#{} not sent: {}", reply.client, reply.correlation_id, e.what());
+  }
+}
+
+bool ReplyCache::begin(const Key& key, std::optional<dds::Reply>& cached) {
+  std::lock_guard lock(mutex_);
+  if (const auto it = replies_.find(key); it != replies_.end()) {
+    cached = it->second;
+    return false;
+  }
+  replies_.emplace(key, std::nullopt);
+  order_.push_back(key);
+  if (order_.size() > kCapacity) {
+    replies_.erase(order_.front());
+    order_.pop_front();
+  }
+  return true;
+}
+
+void ReplyCache::finish(const Key& key, const dds::Reply& reply) {
+  std::lock_guard lock(mutex_);
+  if (const auto it = replies_.find(key); it != replies_.end()) it->second = reply;
+}
+
+}  // namespace dynid::server

@@ -1,0 +1,69 @@
+#pragma once
+// Server::Impl: the members of the server and the dispatcher's steps (server.cpp, dispatch.cpp).
+#include <atomic>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <optional>
+
+#include "dynid.h"
+#include "dynid/dds/reader.hpp"
+#include "dynid/dds/request.hpp"
+#include "dynid/server/request_parser.hpp"
+#include "dynid/server/run_service.hpp"
+#include "dynid/server/server.hpp"
+#include "dynid/server/worker_pool.hpp"
+
+namespace dynid::server {
+
+/// Recent replies by (client, correlation id); nullopt while the request is being executed.
+class ReplyCache {
+ public:
+  using Key = std::pair<std::string, std::uint64_t>;
+  /// True when the key is new (and now marked in flight); false with the cached reply, if any.
+  bool begin(const Key& key, std::optional<dds::Reply>& cached);
+  void finish(const Key& key, const dds::Reply& reply);
+
+ private:
+  static constexpr std::size_t kCapacity = 256;
+  std::mutex mutex_;
+  std::map<Key, std::optional<dds::Reply>> replies_;
+  std::deque<Key> order_;
+};
+
+struct Server::Impl {
+  explicit Impl(ServerOptions options);
+  ~Impl();
+
+  void resume_open_runs();
+  void dispatch_round();
+  void dispatch_announcements();
+  void dispatch_chunks();
+  void dispatch_requests();
+  void dispatch_chunk(const dynid_wire_Chunk& sample);
+  void accept_request(const dds::Request& request);
+  dds::Reply execute(const ParsedRequest& request, RunService& service);
+  std::string fleet_reply(const ParsedRequest& request);
+  void send(const dds::Reply& reply);
+
+  ServerOptions options;
+  ServerCounters counters;
+  SharedStore store;
+  dds::Participant participant;
+  RevisionClock revisions;
+  ServerContext context{options, store, counters, participant, revisions};
+  dds::Reader<dynid_wire_RunAnnouncement> announcements;
+  dds::Reader<dynid_wire_Chunk> chunks;
+  dds::Reader<dynid_wire_Request> requests;
+  dds::Writer<dynid_wire_Reply> replies;
+  std::mutex reply_mutex;
+  ReplyCache reply_cache;
+  std::vector<std::unique_ptr<RunService>> services;  // one per worker
+  WorkerPool pool;  // after the services it uses: stopped and destroyed first
+  dds::Entity waitset;
+  dds::Entity stop_guard;
+  std::vector<dds::Entity> conditions;
+  std::atomic<bool> stopping{false};
+};
+
+}  // namespace dynid::server
