@@ -1,0 +1,53 @@
+#pragma once
+// RequestClient: the engineer's side of the Request/Reply pair (DESIGN.md, "DDS interface").
+//
+// Contract:
+// - call() numbers the request (correlation id), waits until a server's Request reader and
+//   Reply writer are matched, writes the request, and returns the reply carrying the same
+//   (client, correlation id); replies to others are ignored. It resends the same request
+//   every `resend` while no reply came (a reply written before the server had discovered our
+//   reader is lost; the server answers a repeat from its reply cache, it does not run the
+//   request twice).
+// - Every wait is bounded by `timeout`: NoServer is thrown, with a message saying what was
+//   waited for and what to check, when no server matched or none answered in time.
+// - The Participant must outlive the client.
+#include <chrono>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "dynid.h"
+#include "dynid/dds/participant.hpp"
+#include "dynid/dds/reader.hpp"
+#include "dynid/dds/request.hpp"
+#include "dynid/dds/writer.hpp"
+
+namespace dynid::cli {
+
+class NoServer : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// "<user>@<host>/<pid>", cut to the wire's id length.
+std::string default_client_id();
+
+class RequestClient {
+ public:
+  RequestClient(const dds::Participant& participant, std::string client_id);
+
+  dds::Reply call(const std::string& kind, const std::vector<dds::RequestArgument>& arguments,
+                  std::chrono::milliseconds timeout,
+                  std::chrono::milliseconds resend = std::chrono::milliseconds(1000));
+
+  const std::string& client_id() const { return client_id_; }
+
+ private:
+  std::string client_id_;
+  std::uint64_t next_correlation_ = 1;
+  dds::Reader<dynid_wire_Reply> replies_;  // before the writer: ready when the request leaves
+  dds::Writer<dynid_wire_Request> requests_;
+};
+
+}  // namespace dynid::cli

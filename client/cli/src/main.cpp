@@ -1,0 +1,159 @@
+// dynid: the engineers' command line. Every command but `watch` is one request to dynid-server
+// (RequestClient); `watch` reads the transient-local Estimate topic of a vehicle, so it shows
+// the latest estimates at once and every update after, for --seconds.
+//
+// Exit codes: 0 ok, 2 bad request (or bad command line), 3 not found, 4 the server failed,
+// 5 no server answered in time.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdlib>
+#include <iostream>
+
+#include "dynid/cli/request_client.hpp"
+#include "dynid/dds/conversions.hpp"
+#include "dynid/dds/topics.hpp"
+#include "dynid/report/estimate_report.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+using dynid::dds::RequestArgument;
+
+struct Common {
+  std::string config;
+  dds_domainid_t domain = 0;
+  double timeout_s = 10.0;
+  bool json = false;
+};
+
+// A file path becomes a file:// URI; URIs and XML fragments pass as they are (CYCLONEDDS_URI
+// syntax). There is no default: Cyclone's own would pick the machine's default interface.
+std::string config_uri(const std::string& value) {
+  const bool literal = value.rfind("file://", 0) == 0 || (!value.empty() && value.front() == '<');
+  return literal ? value : dynid::dds::config_file_uri(value);
+}
+
+int exit_code(dynid::dds::ReplyStatus status) {
+  switch (status) {
+    case dynid::dds::ReplyStatus::kOk: return 0;
+    case dynid::dds::ReplyStatus::kBadRequest: return 2;
+    case dynid::dds::ReplyStatus::kNotFound: return 3;
+    case dynid::dds::ReplyStatus::kFailed: return 4;
+  }
+  return 4;
+}
+
+int request(const Common& c, const std::string& kind, std::vector<RequestArgument> arguments) {
+  if (c.json) arguments.push_back({"format", "json"});
+  dynid::dds::Participant participant({c.domain, config_uri(c.config)});
+  dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
+  const auto timeout = std::chrono::milliseconds(static_cast<long long>(c.timeout_s * 1000));
+  const dynid::dds::Reply reply = client.call(kind, arguments, timeout);
+  if (reply.status != dynid::dds::ReplyStatus::kOk) {
+    std::cerr << "dynid " << kind << ": " << reply.error << "\n";
+    return exit_code(reply.status);
+  }
+  std::cout << reply.payload;
+  if (!reply.payload.empty() && reply.payload.back() != '\n') std::cout << "\n";
+  return 0;
+}
+
+int watch(const Common& c, const std::string& vehicle, double seconds) {
+  dynid::dds::Participant participant({c.domain, config_uri(c.config)});
+  dynid::dds::Reader<dynid_wire_Estimate> reader(participant, {dynid::dds::vehicle_partition(vehicle)});
+  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long long>(seconds * 1000));
+  std::size_t shown = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    for (auto& sample : reader.wait_take(200ms)) {
+      const auto table = dynid::dds::from_wire(sample.data);
+      std::cout << (c.json ? dynid::report::estimate_json(table) + "\n"
+                           : dynid::report::format_estimate_text(table) + "\n")
+                << std::flush;
+      ++shown;
+    }
+  }
+  if (shown == 0) std::cerr << "dynid watch: no estimate of " << vehicle << " in " << seconds << " s\n";
+  return shown ? 0 : 5;
+}
+
+std::vector<RequestArgument> args(std::initializer_list<std::pair<const char*, std::string>> list) {
+  std::vector<RequestArgument> out;
+  for (const auto& [name, value] : list)
+    if (!value.empty()) out.push_back({name, value});
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Common c;
+  if (const char* env = std::getenv("DYNID_CYCLONE_CONFIG")) c.config = env;
+  CLI::App app{"dynid: vehicles, runs and parameter estimates from dynid-server"};
+  app.require_subcommand(1);
+  app.add_option("--cyclone-config", c.config,
+                 "Cyclone DDS configuration: file, file:// URI or XML (or $DYNID_CYCLONE_CONFIG)");
+  app.add_option("--domain", c.domain, "DDS domain id");
+  app.add_option("--timeout", c.timeout_s, "seconds to wait for the server");
+  app.add_flag("--json", c.json, "JSON instead of text");
+
+  std::string vehicle, run, model, effects;
+  std::vector<std::string> runs;
+  double seconds = 10.0;
+  auto* vehicles_cmd = app.add_subcommand("vehicles", "list the vehicles");
+  auto* runs_cmd = app.add_subcommand("runs", "list a vehicle's runs with their ledger marks");
+  runs_cmd->add_option("--vehicle", vehicle)->required();
+  auto* estimates_cmd = app.add_subcommand("estimates", "estimate tables (latest run by default)");
+  estimates_cmd->add_option("--vehicle", vehicle)->required();
+  estimates_cmd->add_option("--run", run);
+  estimates_cmd->add_option("--model", model);
+  auto* watch_cmd = app.add_subcommand("watch", "print estimates as they are published");
+  watch_cmd->add_option("--vehicle", vehicle)->required();
+  watch_cmd->add_option("--seconds", seconds, "how long to watch")->check(CLI::PositiveNumber);
+  auto* pooled_cmd = app.add_subcommand("pooled", "estimate over several runs of a vehicle");
+  pooled_cmd->add_option("--vehicle", vehicle)->required();
+  pooled_cmd->add_option("--run", runs, "runs to pool (repeat)")->required();
+  pooled_cmd->add_option("--model", model);
+  auto* reprocess_cmd = app.add_subcommand("reprocess", "replay a run with another model/effects");
+  reprocess_cmd->add_option("--vehicle", vehicle)->required();
+  reprocess_cmd->add_option("--run", run)->required();
+  reprocess_cmd->add_option("--model", model)->required();
+  reprocess_cmd->add_option("--effects", effects, "comma-separated candidate effects");
+  auto* base_cmd = app.add_subcommand("base", "base-parameter report of a run's model");
+  base_cmd->add_option("--vehicle", vehicle)->required();
+  base_cmd->add_option("--run", run)->required();
+  base_cmd->add_option("--model", model)->required();
+  auto* close_cmd = app.add_subcommand("close", "close a run (final estimates)");
+  close_cmd->add_option("--vehicle", vehicle)->required();
+  close_cmd->add_option("--run", run)->required();
+  auto* status_cmd = app.add_subcommand("status", "the server's counters");
+  CLI11_PARSE(app, argc, argv);
+  if (c.config.empty()) {
+    std::cerr << "dynid: --cyclone-config (or DYNID_CYCLONE_CONFIG) is required, e.g. "
+                 "deploy/cyclonedds/loopback.xml\n";
+    return 2;
+  }
+  try {
+    if (*vehicles_cmd) return request(c, "vehicles", {});
+    if (*runs_cmd) return request(c, "runs", args({{"vehicle", vehicle}}));
+    if (*estimates_cmd)
+      return request(c, "estimate", args({{"vehicle", vehicle}, {"run", run}, {"model", model}}));
+    if (*watch_cmd) return watch(c, vehicle, seconds);
+    if (*pooled_cmd) {
+      auto a = args({{"vehicle", vehicle}, {"model", model}});
+      for (const auto& r : runs) a.push_back({"run", r});
+      return request(c, "pooled", a);
+    }
+    if (*reprocess_cmd)
+      return request(c, "reprocess", args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects}}));
+    if (*base_cmd) return request(c, "base", args({{"vehicle", vehicle}, {"run", run}, {"model", model}}));
+    if (*close_cmd) return request(c, "close", args({{"vehicle", vehicle}, {"run", run}}));
+    if (*status_cmd) return request(c, "status", {});
+  } catch (const dynid::cli::NoServer& e) {
+    std::cerr << "dynid: " << e.what() << "\n";
+    return 5;
+  } catch (const std::exception& e) {
+    std::cerr << "dynid: " << e.what() << "\n";
+    return 2;
+  }
+  return 2;
+}

@@ -1,0 +1,52 @@
+#include "dynid/cli/request_client.hpp"
+
+#include <unistd.h>
+
+#include <cstdlib>
+
+#include "dynid/dds/conversions.hpp"
+
+namespace dynid::cli {
+
+std::string default_client_id() {
+  char host[256] = {};
+  gethostname(host, sizeof host - 1);
+  const char* user = std::getenv("USER");
+  std::string id = std::string(user ? user : "engineer") + "@" + host + "/" + std::to_string(getpid());
+  return id.substr(0, 64);
+}
+
+RequestClient::RequestClient(const dds::Participant& participant, std::string client_id)
+    : client_id_(std::move(client_id)), replies_(participant, {}), requests_(participant, {}) {}
+
+dds::Reply RequestClient::call(const std::string& kind,
+                               const std::vector<dds::RequestArgument>& arguments,
+                               std::chrono::milliseconds timeout,
+                               std::chrono::milliseconds resend) {
+  using clock = std::chrono::steady_clock;
+  const auto deadline = clock::now() + timeout;
+  const auto left = [&] {
+    return std::max(std::chrono::milliseconds(0),
+                    std::chrono::duration_cast<std::chrono::milliseconds>(deadline - clock::now()));
+  };
+  if (!requests_.wait_for_readers(1, left()) || !replies_.wait_for_writers(1, left()))
+    throw NoServer("no dynid-server found within " + std::to_string(timeout.count()) +
+                   " ms (is one running on this DDS domain with the same Cyclone configuration?)");
+  const dds::Request request{client_id_, next_correlation_++, kind, arguments};
+  const auto sample = dds::to_wire(request);
+  while (clock::now() < deadline) {
+    requests_.write(sample.data);
+    const auto resend_at = std::min(deadline, clock::now() + resend);
+    while (clock::now() < resend_at) {
+      const auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(resend_at - clock::now());
+      for (auto& received : replies_.wait_take(wait)) {
+        dds::Reply reply = dds::from_wire(received.data);
+        if (reply.client == client_id_ && reply.correlation_id == request.correlation_id) return reply;
+      }
+    }
+  }
+  throw NoServer("dynid-server did not answer '" + kind + "' within " +
+                 std::to_string(timeout.count()) + " ms");
+}
+
+}  // namespace dynid::cli
