@@ -28,7 +28,6 @@ constexpr double kSpeedIntegralGain = 0.15;
 // Launch: how hard the driver fights for engine speed while the clutch slips, N m per rad/s.
 constexpr double kLaunchEngineGain = 0.6;
 constexpr double kLaunchBaseTorque = 40.0;
-constexpr double kWaitTime = 1.0;        // s standing before each launch
 constexpr double kStandstillSpeed = 0.05;
 constexpr double kVariationFrequency = 1.3;  // Hz of the throttle variation
 
@@ -109,7 +108,7 @@ void Driver::launch(double t, const State& s, DriverInputs& in) {
       in.clamp_load = 0.0;  // pedal down, revving to the launch speed
       in.brake_pressure = spec_.stop_pressure;
       in.throttle_torque = std::max(0.0, engine_hold);
-      if (since >= kWaitTime) { phase_ = Phase::Engage; phase_start_ = t; }
+      if (since >= spec_.wait_time) { phase_ = Phase::Engage; phase_start_ = t; }
       break;
     case Phase::Engage:
       in.clamp_load = d.clutch_max_clamp_load * std::min(1.0, since / spec_.engagement_time);

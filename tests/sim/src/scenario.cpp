@@ -86,7 +86,7 @@ void read_manoeuvre(const Reader& r, const toml::table& t, ManoeuvreSpec& m) {
       {"torque_variation", &m.torque_variation}, {"shift_speed", &m.shift_speed},
       {"shift_time", &m.shift_time}, {"launch_engine_speed", &m.launch_engine_speed},
       {"engagement_time", &m.engagement_time}, {"rev_limit", &m.rev_limit},
-      {"stop_pressure", &m.stop_pressure}};
+      {"stop_pressure", &m.stop_pressure}, {"wait_time", &m.wait_time}};
   for (const auto& [k, node] : t) {
     const std::string name(k.str());
     const std::string key = "manoeuvre." + name;
@@ -153,6 +153,7 @@ void check(const Reader& r, const Scenario& s) {
   if (!(m.sweep_time > 0.0)) r.fail("manoeuvre.sweep_time", "must be > 0");
   if (!(m.ramp_time > 0.0)) r.fail("manoeuvre.ramp_time", "must be > 0");
   if (!(m.engagement_time > 0.0)) r.fail("manoeuvre.engagement_time", "must be > 0");
+  if (!(m.wait_time > 0.0)) r.fail("manoeuvre.wait_time", "must be > 0");
   if (!(m.shift_time > 0.0)) r.fail("manoeuvre.shift_time", "must be > 0");
   const auto& v = s.car.vehicle;
   if (!(v.mass > 2.0 * (v.unsprung_mass_front + v.unsprung_mass_rear)))

@@ -44,6 +44,7 @@ struct ManoeuvreSpec {
   double engagement_time = 1.5;   // launch: clamp load 0 -> max, s
   double rev_limit = 450.0;       // launch: stop driving when the engine reaches this, rad/s
   double stop_pressure = 2.0e6;   // launch: brake pressure to stop, Pa
+  double wait_time = 1.0;         // launch: standing, clutch pedal down, before each launch, s
 };
 
 class Driver {
