@@ -88,6 +88,30 @@ TEST(ClutchSlip, ClampLoadZeroFromTheTareIsSubtractedInEveryFrictionColumn) {
   EXPECT_GT(relative_error(raw.value("coulomb_friction"), kClio.coulomb), 1e-3);
 }
 
+// Clutch pedal down: the true load is 0 and the sensor reads noise around it; with
+// open_clamp_load those rows carry no friction column (only J_e), and the recovery stays exact.
+TEST(ClutchSlip, OpenClampLoadTakesTheFrictionOutOfClutchOpenRows) {
+  const model::ChannelSet clean = slipping_run(kClio, kEngineInertia);
+  const Eigen::Index n = clean.samples();
+  Eigen::VectorXd load = clean["clutch_clamp_load"], torque = clean["engine_torque"];
+  for (Eigen::Index k = 1000; k < 1600; ++k) {
+    load(k) = 60.0 * std::sin(0.37 * static_cast<double>(k));  // noise of an unloaded sensor
+    torque(k) = kEngineInertia * clean["d_engine_speed"](k);    // no clutch torque
+  }
+  model::ChannelSet set(clean.sample_period(), n);
+  for (const auto& name : clean.names())
+    if (name != "clutch_clamp_load" && name != "engine_torque") set.add(name, clean.unit(name), clean[name]);
+  set.add("clutch_clamp_load", "N", load);
+  set.add("engine_torque", "N m", torque);
+  const model::Constants constants{
+      {"clutch_friction_radius", kRadius}, {"stribeck_speed", kClio.speed}, {"open_clamp_load", 100.0}};
+  const Identified id =
+      identify(*model::make_model("clutch_slip", constants), set, {"viscous_friction", "stribeck_friction"});
+  EXPECT_LT(relative_error(id.value("engine_inertia"), kEngineInertia), 1e-6);
+  EXPECT_LT(relative_error(id.value("coulomb_friction"), kClio.coulomb), 1e-6);
+  EXPECT_LT(relative_error(id.value("viscous_friction"), kClio.viscous), 1e-6);
+}
+
 // A low-passed run smears what happens while the clutch sticks into the rows around it; with
 // stick_margin those rows are left out. Here the torque within 0.1 s of a near-zero slip is
 // spoiled (as a filter would spoil it): with a 0.1 s margin the recovery stays exact.

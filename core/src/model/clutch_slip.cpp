@@ -1,6 +1,7 @@
 #include "dynid/model/clutch_slip.hpp"
 
 #include <cmath>
+#include <functional>
 
 #include "dynid/model/effects.hpp"
 #include "support.hpp"
@@ -16,6 +17,7 @@ ClutchSlipModel::ClutchSlipModel(const Constants& constants) {
     stribeck_speed_ = c.positive("stribeck_speed", "rad/s, Stribeck speed v_s");
   min_slip_ = c.positive_or("min_slip_speed", 1e-3);
   clamp_load_zero_ = c.optional("clutch_clamp_load_zero").value_or(0.0);
+  open_clamp_load_ = c.optional("open_clamp_load").value_or(0.0);
   stick_margin_ = c.optional("stick_margin").value_or(0.0);
   // A negative margin is an error: positive() throws naming the constant.
   if (stick_margin_ < 0.0) stick_margin_ = c.positive("stick_margin", "s, >= 0");
@@ -35,6 +37,13 @@ std::vector<bool> ClutchSlipModel::near_stick(const ChannelSet& set) const {
   return out;
 }
 
+std::function<double(double)> ClutchSlipModel::clamp_load() const {
+  return [zero = clamp_load_zero_, open = open_clamp_load_](double measured) {
+    const double load = measured - zero;
+    return load < open ? 0.0 : load;
+  };
+}
+
 std::vector<ParameterInfo> ClutchSlipModel::parameters() const {
   return {parameter("engine_inertia", "kg m^2", "engine and flywheel inertia J_e"),
           parameter("coulomb_friction", "-", "Coulomb friction coefficient mu_c")};
@@ -51,12 +60,12 @@ std::vector<ChannelNeed> ClutchSlipModel::channels() const {
 RowModel::EffectDefinition ClutchSlipModel::friction_effect(Effect info,
                                                             std::function<double(double)> law) const {
   return detail::one_column(
-      std::move(info), [law = std::move(law), radius = radius_, zero = clamp_load_zero_](const ChannelSet& set) {
+      std::move(info), [law = std::move(law), radius = radius_, gamma = clamp_load()](const ChannelSet& set) {
         const Eigen::VectorXd& we = set["engine_speed"];
         const Eigen::VectorXd& wi = set["gearbox_input_speed"];
         const Eigen::VectorXd& load = set["clutch_clamp_load"];
-        return detail::ValueFn([&we, &wi, &load, law, radius, zero](Eigen::Index k) {
-          return (load(k) - zero) * radius * law(we(k) - wi(k));
+        return detail::ValueFn([&we, &wi, &load, law, radius, gamma](Eigen::Index k) {
+          return gamma(load(k)) * radius * law(we(k) - wi(k));
         });
       });
 }
@@ -92,12 +101,12 @@ RowModel::RowFn ClutchSlipModel::bind(const ChannelSet& set,
   const Eigen::VectorXd& te = set["engine_torque"];
   const Eigen::VectorXd& wi = set["gearbox_input_speed"];
   const Eigen::VectorXd& load = set["clutch_clamp_load"];
-  return [&, radius = radius_, zero = clamp_load_zero_, stuck = near_stick(set)](Eigen::Index k, std::size_t,
+  return [&, radius = radius_, gamma = clamp_load(), stuck = near_stick(set)](Eigen::Index k, std::size_t,
                                                                                 double* w, double& y) {
     const double slip = we(k) - wi(k);
     if (stuck[static_cast<std::size_t>(k)]) return false;
     w[0] = dwe(k);
-    w[1] = (load(k) - zero) * radius * detail::sgn(slip);
+    w[1] = gamma(load(k)) * radius * detail::sgn(slip);
     y = te(k);
     return true;
   };

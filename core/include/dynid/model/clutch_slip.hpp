@@ -23,7 +23,7 @@
 //
 // Constants: clutch_friction_radius (m); optional stribeck_speed (rad/s; without it the
 // stribeck_friction effect is not offered), min_slip_speed (rad/s, 1e-3), stick_margin (s, 0),
-// clutch_clamp_load_zero (N, 0).
+// clutch_clamp_load_zero (N, 0), open_clamp_load (N, 0).
 //
 // clutch_clamp_load_zero: what the clamp-load sensor reads with the clutch fully open (zero
 // load), from the run's tare (ingest/zero_calibration.hpp); every friction column uses
@@ -32,7 +32,16 @@
 // its Coulomb part is a constant torque on a launch (slip always > 0), the same column as
 // engine_torque_offset; and its viscous part R F0 mu_v dw is a column the model does not have,
 // weighing most where the load is small (engagement starts from 0, and the clutch-open rows of
-// a standing start carry F0 alone).
+// a standing start carry F0 alone). The engaging slip of a launch happens at small loads (the
+// clutch locks at ~3-4 kN of 12 kN on the reference simulator), so mu_c moves by ~0.3 % per N
+// of zero error: a 1 s tare (~5 N) is not enough, 5 s (~2 N) is.
+//
+// open_clamp_load: below it (after the zero) the clutch counts as open, Gamma_n = 0: the rows
+// of a standing or stopping car (clutch pedal down, large slip) keep J_e and the torque offset
+// and carry no friction column. Why: there the measured load is the sensor's noise and residual
+// zero error, which the friction columns multiply by mu(dw) at slips up to ~250 rad/s (viscous
+// term), spoiling J_e and mu_c; the true friction torque below the threshold is at most
+// mu R open_clamp_load (150 N: < 3 N m). Choose ~5 sigma of the load sensor's noise.
 // Effects: viscous_friction, stribeck_friction, engine_torque_offset (ECU torque = true - T0).
 #include <optional>
 
@@ -59,6 +68,10 @@ class ClutchSlipModel final : public RowModel {
   // A column Gamma_n * law(slip).
   EffectDefinition friction_effect(Effect info, std::function<double(double)> law) const;
 
+  // The clamp load the friction columns use, from the measured one: the tare's zero removed,
+  // and 0 below open_clamp_load.
+  std::function<double(double)> clamp_load() const;
+
   // Per sample: within stick_margin of a sample whose |slip| < min_slip_speed.
   std::vector<bool> near_stick(const ChannelSet& channels) const;
 
@@ -67,6 +80,7 @@ class ClutchSlipModel final : public RowModel {
   double min_slip_;
   double stick_margin_ = 0.0;  // s
   double clamp_load_zero_ = 0.0;  // N
+  double open_clamp_load_ = 0.0;  // N
 };
 
 }  // namespace dynid::model
