@@ -24,6 +24,11 @@ CREATE TABLE IF NOT EXISTS acks (
   run      TEXT NOT NULL,
   sequence INTEGER NOT NULL,
   PRIMARY KEY (vehicle, run));
+CREATE TABLE IF NOT EXISTS announcements (
+  vehicle  TEXT NOT NULL,
+  run      TEXT NOT NULL,
+  data     BLOB NOT NULL,                       -- ingest::encode_announcement
+  PRIMARY KEY (vehicle, run));
 )sql";
 
 // A prepared statement that finalizes itself; errors carry SQLite's message.
@@ -177,6 +182,12 @@ void Spool::acknowledge(const std::string& vehicle, const std::string& run, std:
     Statement d(db_, "DELETE FROM chunks WHERE vehicle = ?1 AND run = ?2 AND sequence <= ?3");
     d.bind(1, vehicle).bind(2, run).bind(3, sequence);
     d.step();
+    // The server acknowledged the run, so it holds its announcement: keep ours only while
+    // chunks remain to resend after a restart.
+    Statement r(db_, "DELETE FROM announcements WHERE vehicle = ?1 AND run = ?2 AND NOT EXISTS "
+                     "(SELECT 1 FROM chunks WHERE vehicle = ?1 AND run = ?2)");
+    r.bind(1, vehicle).bind(2, run);
+    r.step();
     exec("COMMIT");
   } catch (...) {
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
@@ -192,6 +203,51 @@ std::optional<std::uint64_t> Spool::acknowledged(const std::string& vehicle, con
   s.bind(1, vehicle).bind(2, run);
   if (!s.step()) return std::nullopt;
   return s.u64(0);
+}
+
+void Spool::store_announcement(const ingest::RunAnnouncement& announcement) {
+  const std::string bytes = ingest::encode_announcement(announcement);
+  const std::string name = announcement.vehicle + "/" + announcement.run;
+  {
+    Statement s(db_, "SELECT data FROM announcements WHERE vehicle = ?1 AND run = ?2");
+    s.bind(1, announcement.vehicle).bind(2, announcement.run);
+    if (s.step()) {
+      if (s.blob(0) == bytes) return;  // announced again after a restart
+      throw InputError("spool: run " + name + " is already announced with another layout");
+    }
+  }
+  Statement s(db_, "INSERT INTO announcements (vehicle, run, data) VALUES (?1, ?2, ?3)");
+  s.bind(1, announcement.vehicle).bind(2, announcement.run).bind_blob(3, bytes);
+  s.step();  // autocommit: durable when this returns
+}
+
+std::vector<ingest::RunAnnouncement> Spool::pending_announcements() const {
+  std::vector<ingest::RunAnnouncement> out;
+  Statement s(db_, "SELECT a.vehicle, a.run, a.data FROM announcements a JOIN "
+                   "(SELECT vehicle, run, MIN(id) AS first FROM chunks GROUP BY vehicle, run) c "
+                   "ON a.vehicle = c.vehicle AND a.run = c.run ORDER BY c.first");
+  while (s.step()) {
+    try {
+      out.push_back(ingest::decode_announcement(s.blob(2)));
+    } catch (const InputError& e) {
+      throw InputError("spool " + file_.string() + ": announcement of " + s.text(0) + "/" + s.text(1) +
+                       " is corrupted: " + e.what());
+    }
+  }
+  return out;
+}
+
+std::optional<ingest::Chunk> Spool::load(const std::string& vehicle, const std::string& run,
+                                         std::uint64_t sequence) const {
+  Statement s(db_, "SELECT data FROM chunks WHERE vehicle = ?1 AND run = ?2 AND sequence = ?3");
+  s.bind(1, vehicle).bind(2, run).bind(3, sequence);
+  if (!s.step()) return std::nullopt;
+  try {
+    return ingest::decode_chunk(s.blob(0));
+  } catch (const InputError& e) {
+    throw InputError("spool " + file_.string() + ": chunk " + chunk_name(vehicle, run, sequence) +
+                     " is corrupted: " + e.what());
+  }
 }
 
 std::vector<ingest::Chunk> Spool::pending() const {

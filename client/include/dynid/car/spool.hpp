@@ -25,6 +25,13 @@
 //   order within a run, also after reopening the spool (a client restart).
 // - A corrupted chunk read back (CRC) throws InputError naming the chunk; the spool's own I/O
 //   failures throw std::runtime_error with SQLite's message and the file.
+// - Announcements: store_announcement() keeps a run's announcement durably (the same bytes
+//   again are a no-op; another announcement for the same vehicle and run throws InputError), so
+//   a restarted client can announce its pending runs again before resending their chunks.
+//   pending_announcements() lists those of runs that still have chunks in the spool, in the
+//   order of their oldest chunk. An acknowledgement that leaves a run without chunks deletes its
+//   announcement too: the server acknowledged the run, so it holds the announcement. Not
+//   counted in bytes(): one small row per run.
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -33,6 +40,7 @@
 #include <vector>
 
 #include <dynid/ingest/chunk.hpp>
+#include <dynid/ingest/run_announcement.hpp>
 
 struct sqlite3;
 
@@ -60,6 +68,13 @@ class Spool {
 
   void store(const ingest::Chunk& chunk);
   void acknowledge(const std::string& vehicle, const std::string& run, std::uint64_t sequence);
+
+  void store_announcement(const ingest::RunAnnouncement& announcement);
+  /// Announcements of the runs with chunks in the spool, oldest pending chunk first.
+  std::vector<ingest::RunAnnouncement> pending_announcements() const;
+  /// One unacknowledged chunk (decoded and CRC-checked), or nothing if it is not in the spool.
+  std::optional<ingest::Chunk> load(const std::string& vehicle, const std::string& run,
+                                    std::uint64_t sequence) const;
 
   /// The unacknowledged chunks, oldest first (decoded and CRC-checked).
   std::vector<ingest::Chunk> pending() const;

@@ -1,0 +1,114 @@
+#pragma once
+// Delivery: the car's side of the acknowledgement protocol. Every chunk goes into the Spool
+// before it is published, and leaves the spool only when the server acknowledges it durably
+// (ChunkAck.highest_contiguous). Whatever is unacknowledged is sent again, oldest first, when
+// the link seems lost or a server (re)appears, and after a restart of the car.
+//
+// Contract:
+// - The constructor picks up what an earlier process left in the spool: it announces the
+//   pending runs again (their stored announcements) and queues their chunks in storage order,
+//   ahead of anything new. Nothing is sent twice on purpose, except by a resend below.
+// - announce() stores the run's announcement in the spool, then publishes it.
+// - submit() stores the chunk (durable when it returns; SpoolFull and InputError propagate and
+//   nothing is queued), then sends it if the window allows. It never drops a chunk.
+// - At most `window` chunks are in flight (sent, not yet acknowledged): the server reads chunks
+//   keep-all with bounded depth, and a car must not overrun it. The rest wait in the spool and
+//   go out, in order, as acknowledgements free the window.
+// - service() takes the acknowledgements (waiting up to `wait` for the first), prunes the spool
+//   to each run's highest contiguous sequence, reports new rejections of unacknowledged chunks
+//   once each (with the server's reason; a rejected chunk stays in the spool and holds up its
+//   run), and resends everything in flight from the oldest unacknowledged chunk when (a) no
+//   acknowledgement made progress for ack_timeout while chunks were in flight (a lost link),
+//   (b) a new chunk reader matched (a server started or restarted and missed the volatile
+//   chunks), or (c) a new rejection named a chunk still in the spool (e.g. it overtook its run's
+//   announcement; a rejection that repeats with the same reason does not trigger it again).
+// - server_knows() tells whether the server published any receipt for the run: it does when it
+//   accepts an announcement, so a replay can wait for it before sending the run's chunks.
+// - drain() services until the spool holds nothing or `timeout` passes; returns drained().
+// - Single-threaded: the caller interleaves submit() and service() (the replay's callbacks, the
+//   live loop's timeouts). Spool and Uplink must outlive the Delivery.
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <set>
+#include <string>
+#include <tuple>
+#include <utility>
+
+#include "dynid/car/spool.hpp"
+#include "dynid/car/uplink.hpp"
+
+namespace dynid::car {
+
+enum class LogLevel { info, warning, error };
+using DeliveryLog = std::function<void(LogLevel, const std::string&)>;
+
+struct DeliveryOptions {
+  std::chrono::milliseconds ack_timeout{5000};
+  std::size_t window = 32;  ///< below the chunk QoS's 64 unread samples per run
+};
+
+struct DeliveryStats {
+  std::uint64_t submitted = 0;     ///< chunks stored by this process
+  std::uint64_t sent = 0;          ///< first sends by this process
+  std::uint64_t resent = 0;        ///< sends of a chunk sent before (or left by an earlier process)
+  std::uint64_t acknowledged = 0;  ///< chunks pruned from the spool by acknowledgements
+  std::uint64_t resend_rounds = 0;
+  std::uint64_t blocked = 0;       ///< sends refused because the server's queue stayed full
+  std::uint64_t rejections = 0;    ///< distinct rejections reported by the server
+};
+
+class Delivery {
+ public:
+  Delivery(Spool& spool, Uplink& uplink, DeliveryOptions options = {}, DeliveryLog logger = {});
+
+  void announce(const ingest::RunAnnouncement& announcement);
+  void submit(const ingest::Chunk& chunk);
+  void service(std::chrono::milliseconds wait);
+  bool drain(std::chrono::milliseconds timeout);
+
+  bool drained() const { return queue_.empty(); }
+  bool server_knows(const std::string& vehicle, const std::string& run) const {
+    return known_runs_.count({vehicle, run}) > 0;
+  }
+  /// Chunks in the spool (this process's and earlier ones').
+  std::size_t pending() const { return queue_.size(); }
+  std::size_t in_flight() const { return sent_; }
+  const DeliveryStats& stats() const { return stats_; }
+  /// Why the oldest pending chunk is not acknowledged, as far as the car knows (a rejection's
+  /// reason, or that no server matched), for the final message; empty when drained.
+  std::string holdup() const;
+
+ private:
+  struct Entry {
+    std::string vehicle;
+    std::string run;
+    std::uint64_t sequence = 0;
+    bool sent_before = false;
+  };
+  using Clock = std::chrono::steady_clock;
+
+  /// True when the receipt brings a new rejection of a chunk still in the spool.
+  bool on_receipt(const dds::ChunkReceipt& receipt);
+  void acknowledge(const std::string& vehicle, const std::string& run, std::uint64_t through);
+  void restart_round(const std::string& why);
+  void pump();
+  void log(LogLevel level, const std::string& message) const;
+
+  Spool& spool_;
+  Uplink& uplink_;
+  DeliveryOptions options_;
+  DeliveryLog log_;
+  std::deque<Entry> queue_;  // the spool's chunks, storage order
+  std::size_t sent_ = 0;     // queue_[0, sent_) are in flight in the current round
+  Clock::time_point last_progress_;
+  std::uint32_t readers_seen_ = 0;
+  std::set<std::tuple<std::string, std::uint64_t, std::string>> rejections_seen_;
+  std::map<std::pair<std::string, std::uint64_t>, std::string> rejected_;  // (run, seq) -> reason
+  std::set<std::pair<std::string, std::string>> known_runs_;  // (vehicle, run) with a receipt
+  DeliveryStats stats_;
+};
+
+}  // namespace dynid::car

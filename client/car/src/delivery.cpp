@@ -1,0 +1,148 @@
+#include "dynid/car/delivery.hpp"
+
+#include <algorithm>
+
+namespace dynid::car {
+namespace {
+
+// The sequence the server's receipt carries for a rejection of the announcement itself
+// (dynid-server, run_service.hpp: kAnnouncementSequence).
+constexpr std::uint64_t kAnnouncementSequence = ~std::uint64_t{0};
+
+std::string name_of(const std::string& vehicle, const std::string& run, std::uint64_t sequence) {
+  if (sequence == kAnnouncementSequence) return "the announcement of " + vehicle + "/" + run;
+  return vehicle + "/" + run + "#" + std::to_string(sequence);
+}
+
+}  // namespace
+
+Delivery::Delivery(Spool& spool, Uplink& uplink, DeliveryOptions options, DeliveryLog logger)
+    : spool_(spool), uplink_(uplink), options_(options), log_(std::move(logger)),
+      last_progress_(Clock::now()) {
+  if (options_.window == 0) options_.window = 1;
+  // A restart: the server may never have seen these runs (or lost nothing and acknowledges
+  // them at once from its ledger); either way they are announced before their chunks.
+  const auto runs = spool_.pending_announcements();
+  for (const auto& announcement : runs) uplink_.announce(announcement);
+  for (const auto& e : spool_.pending_entries()) queue_.push_back({e.vehicle, e.run, e.sequence, true});
+  if (!queue_.empty())
+    log(LogLevel::info, "resuming: " + std::to_string(queue_.size()) + " unacknowledged chunks in the spool (" +
+                            std::to_string(runs.size()) + " runs announced again), oldest " +
+                            name_of(queue_.front().vehicle, queue_.front().run, queue_.front().sequence));
+}
+
+void Delivery::announce(const ingest::RunAnnouncement& announcement) {
+  spool_.store_announcement(announcement);
+  uplink_.announce(announcement);
+}
+
+void Delivery::submit(const ingest::Chunk& chunk) {
+  spool_.store(chunk);  // durable before it is sent; throws (SpoolFull...) before queueing
+  ++stats_.submitted;
+  queue_.push_back({chunk.vehicle, chunk.run, chunk.sequence, false});
+  service(std::chrono::milliseconds(0));
+}
+
+void Delivery::service(std::chrono::milliseconds wait) {
+  bool rejected = false;
+  for (const auto& receipt : uplink_.receipts(wait)) rejected = on_receipt(receipt) || rejected;
+  if (rejected && sent_ > 0) restart_round("the server rejected a chunk in flight");
+  const std::uint32_t readers = uplink_.readers_matched_total();
+  if (readers > readers_seen_) {
+    readers_seen_ = readers;
+    if (sent_ > 0) restart_round("a server (re)appeared");
+  }
+  if (sent_ > 0 && Clock::now() - last_progress_ > options_.ack_timeout)
+    restart_round("no acknowledgement for " + std::to_string(options_.ack_timeout.count()) + " ms");
+  pump();
+}
+
+bool Delivery::drain(std::chrono::milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  while (!drained()) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+    if (left.count() <= 0) break;
+    service(std::min(left, std::chrono::milliseconds(100)));
+  }
+  return drained();
+}
+
+std::string Delivery::holdup() const {
+  if (queue_.empty()) return {};
+  const Entry& oldest = queue_.front();
+  std::string why = std::to_string(queue_.size()) + " chunks unacknowledged, oldest " +
+                    name_of(oldest.vehicle, oldest.run, oldest.sequence);
+  if (auto it = rejected_.find({oldest.run, oldest.sequence}); it != rejected_.end())
+    return why + ": the server rejected it: " + it->second;
+  if (readers_seen_ == 0) return why + ": no server ever matched the chunk topic";
+  return why + ": no acknowledgement from the server";
+}
+
+bool Delivery::on_receipt(const dds::ChunkReceipt& receipt) {
+  known_runs_.insert({receipt.vehicle, receipt.run});
+  bool pending_rejected = false;
+  for (const auto& r : receipt.rejections) {
+    // Rejections of chunks acknowledged since (a resend went through) are history.
+    const bool settled = r.sequence != kAnnouncementSequence && receipt.highest_contiguous >= 0 &&
+                         r.sequence <= static_cast<std::uint64_t>(receipt.highest_contiguous);
+    if (settled || !rejections_seen_.insert({receipt.run, r.sequence, r.reason}).second) continue;
+    ++stats_.rejections;
+    rejected_[{receipt.run, r.sequence}] = r.reason;
+    log(LogLevel::warning, "server rejected " + name_of(receipt.vehicle, receipt.run, r.sequence) + ": " + r.reason);
+    pending_rejected = pending_rejected || std::any_of(queue_.begin(), queue_.end(), [&](const Entry& e) {
+                         return e.vehicle == receipt.vehicle && e.run == receipt.run && e.sequence == r.sequence;
+                       });
+  }
+  if (receipt.highest_contiguous >= 0)
+    acknowledge(receipt.vehicle, receipt.run, static_cast<std::uint64_t>(receipt.highest_contiguous));
+  return pending_rejected;
+}
+
+void Delivery::acknowledge(const std::string& vehicle, const std::string& run, std::uint64_t through) {
+  const auto covered = [&](const Entry& e) { return e.vehicle == vehicle && e.run == run && e.sequence <= through; };
+  const auto in_flight_end = queue_.begin() + static_cast<std::ptrdiff_t>(sent_);
+  const auto acked_in_flight = static_cast<std::size_t>(std::count_if(queue_.begin(), in_flight_end, covered));
+  const auto before = queue_.size();
+  // The spool first: if the process dies now, the worst case is resending acknowledged chunks.
+  if (std::any_of(queue_.begin(), queue_.end(), covered)) spool_.acknowledge(vehicle, run, through);
+  std::erase_if(queue_, covered);
+  const std::size_t removed = before - queue_.size();
+  if (removed == 0) return;
+  sent_ -= acked_in_flight;
+  stats_.acknowledged += removed;
+  last_progress_ = Clock::now();
+}
+
+void Delivery::restart_round(const std::string& why) {
+  ++stats_.resend_rounds;
+  log(LogLevel::warning, why + ": resending " + std::to_string(queue_.size()) + " unacknowledged chunks from " +
+                             name_of(queue_.front().vehicle, queue_.front().run, queue_.front().sequence));
+  sent_ = 0;
+}
+
+void Delivery::pump() {
+  while (sent_ < queue_.size() && sent_ < options_.window) {
+    Entry& e = queue_[sent_];
+    const auto chunk = spool_.load(e.vehicle, e.run, e.sequence);
+    if (!chunk) {  // cannot happen while the queue mirrors the spool; never send a hole silently
+      log(LogLevel::error, "spool lost " + name_of(e.vehicle, e.run, e.sequence) + " before it was acknowledged");
+      queue_.erase(queue_.begin() + static_cast<std::ptrdiff_t>(sent_));
+      continue;
+    }
+    if (!uplink_.send(*chunk)) {  // the server's queue is full: it is alive, just behind
+      ++stats_.blocked;
+      last_progress_ = Clock::now();
+      return;
+    }
+    if (sent_ == 0) last_progress_ = Clock::now();  // the ack timeout runs from the first send
+    ++(e.sent_before ? stats_.resent : stats_.sent);
+    e.sent_before = true;
+    ++sent_;
+  }
+}
+
+void Delivery::log(LogLevel level, const std::string& message) const {
+  if (log_) log_(level, message);
+}
+
+}  // namespace dynid::car
