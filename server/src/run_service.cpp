@@ -251,8 +251,11 @@ void RunService::publish_ack(const store::RunKey& key, const RunState* run,
 void RunService::publish(const store::RunKey& key, RunState& run) {
   run.dirty = false;
   run.last_published = std::chrono::steady_clock::now();
-  auto tables = tables_of(key.vehicle, key.run, run.processor.estimates());
-  auto& writers = outputs_.writers(context_.participant, key.vehicle);
+  publish_tables(key.vehicle, tables_of(key.vehicle, key.run, run.processor.estimates()));
+}
+
+void RunService::publish_tables(const std::string& vehicle, EstimateTables tables) {
+  auto& writers = outputs_.writers(context_.participant, vehicle);
   for (auto& table : tables.tables) {
     table.revision = context_.revisions.next();
     writers.estimate.write(to_wire(table).data);

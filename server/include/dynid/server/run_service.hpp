@@ -79,6 +79,7 @@ class RunService {
   // Run-level requests. InputError/NotFound name what is wrong.
   EstimateTables estimate(const std::string& vehicle, const std::optional<std::string>& run,
                           const std::optional<std::string>& model);
+  /// Also published on the Estimate topic (source "pool:<run>+<run>...").
   EstimateTables pooled(const std::string& vehicle, const std::vector<std::string>& runs,
                         const std::optional<std::string>& model);
   EstimateTables close(const std::string& vehicle, const std::string& run);
@@ -115,6 +116,7 @@ class RunService {
                                          std::uint64_t to);
   void checkpoint(const store::RunKey& key, RunState& run);
   void publish(const store::RunKey& key, RunState& run);
+  void publish_tables(const std::string& vehicle, EstimateTables tables);
   void record_history(const store::RunKey& key, const EstimateTables& tables);
   std::string latest_run(const std::string& vehicle);
 
