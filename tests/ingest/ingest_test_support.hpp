@@ -86,6 +86,57 @@ inline TestRun make_run(Eigen::Index n = 6000, unsigned seed = 1u, const Truth& 
   return run;
 }
 
+/// A run whose model reads far around each row: clutch_slip with a stick margin of 0.4 s (40
+/// samples, more than RunProcessor's least context). Cycles of 5 s: an engagement (clamp load
+/// ramps up, the slip falls linearly to 0), 2 s locked (the torque there is not the friction
+/// law: the mask must leave those rows and the 0.4 s around them out), then the clutch opens
+/// (slip jumps, load 0). Noisy channels, a gap; odmf 7 (rows on every 7th grid sample).
+inline TestRun make_clutch_run(Eigen::Index n = 6000, unsigned seed = 3u) {
+  RunAnnouncement a;
+  a.vehicle = "proto-17";
+  a.run = "launch-0007";
+  a.sample_rate_hz = 100.0;
+  a.channels = {{"engine_speed", "rad/s"},
+                {"engine_torque", "N m"},
+                {"gearbox_input_speed", "rad/s"},
+                {"clutch_clamp_load", "N"}};
+  a.models = {{"clutch_slip",
+               {{"clutch_friction_radius", 0.11},
+                {"min_slip_speed", 2.0},
+                {"stick_margin", 0.4},
+                {"open_clamp_load", 150.0}},
+               {"viscous_friction", "engine_torque_offset"}}};
+  a.preprocessing.odmf = 7;
+  TestRun run{a, Eigen::MatrixXd(n, 4), std::vector<std::uint8_t>(n, 1)};
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  const double inertia = 0.18, radius = 0.11, mu_c = 0.16, mu_v = 0.004, pi = 3.141592653589793;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / 100.0;
+    const double tau = std::fmod(t, 5.0);
+    const double we = 220.0 + 40.0 * std::sin(2.0 * pi * 0.3 * t);
+    const double dwe = 40.0 * 2.0 * pi * 0.3 * std::cos(2.0 * pi * 0.3 * t);
+    double slip = 0.0, load = 0.0, torque = 0.0;
+    if (tau < 1.5) {  // engaging
+      slip = 150.0 * (1.0 - tau / 1.5);
+      load = 4000.0 * tau / 1.5;
+      torque = inertia * dwe + radius * load * (mu_c + mu_v * slip);
+    } else if (tau < 3.5) {  // locked: the engine drives the car, not the friction law
+      load = 8000.0;
+      torque = 60.0 + 10.0 * std::sin(2.0 * pi * 1.1 * t);
+    } else {  // open
+      slip = 20.0 + 30.0 * (tau - 3.5);
+      torque = inertia * dwe;
+    }
+    run.samples(k, 0) = we + 0.3 * noise(rng);
+    run.samples(k, 1) = torque + 1.0 * noise(rng);
+    run.samples(k, 2) = we - slip + 0.3 * noise(rng);
+    run.samples(k, 3) = load + 20.0 * noise(rng);
+  }
+  for (Eigen::Index k = 2210; k < std::min(n, Eigen::Index{2260}); ++k) run.valid[static_cast<std::size_t>(k)] = 0;
+  return run;
+}
+
 /// Cuts [first, first + count) of the run into a sealed chunk.
 inline Chunk cut(const TestRun& run, std::uint64_t sequence, Eigen::Index first,
                  Eigen::Index count) {

@@ -203,8 +203,14 @@ std::vector<ModelEstimate> offline_estimates(const TestRun& run, const RunProces
       }
       for (std::size_t m = 0; m < models.size(); ++m) {
         const std::vector<model::GroupRows> rows = models[m]->rows(set, a.models[m].effects);
-        for (std::size_t g = 0; g < rows.size(); ++g)
-          if (rows[g].y.size() > 0) groups[m].fold(g, rows[g].W, rows[g].y);
+        // DYCARO's decimation: rows on the run's samples whose index is a multiple of odmf.
+        for (std::size_t g = 0; g < rows.size(); ++g) {
+          std::vector<Eigen::Index> keep;
+          for (std::size_t i = 0; i < rows[g].samples.size(); ++i)
+            if ((s + rows[g].samples[i]) % a.preprocessing.odmf == 0)
+              keep.push_back(static_cast<Eigen::Index>(i));
+          if (!keep.empty()) groups[m].fold(g, rows[g].W(keep, Eigen::all), rows[g].y(keep));
+        }
       }
     }
     s = e;
@@ -223,6 +229,61 @@ TEST(RunProcessor, MatchesTheFullyOfflinePathWithinTheFilterTolerance) {
               run.announcement.preprocessing.filter_tolerance, diff);
   EXPECT_LT(diff, 1e-6);
   EXPECT_GT(diff, 0.0);  // the streamed backward pass is an approximation, bounded above
+}
+
+// Decimation (odmf 5 here) keeps the rows on the run's sample grid: the same rows as the
+// offline path's selection, and a fifth of the rows of the same filter without decimation.
+TEST(RunProcessor, DecimationKeepsTheRowsOnTheRunGrid) {
+  const TestRun run = test::make_run();
+  TestRun full = run;
+  full.announcement.preprocessing.cutoff_hz = full.announcement.preprocessing.cutoff(100.0);
+  full.announcement.preprocessing.odmf = 1;
+  const RunProcessor p = processed(run, test::random_cuts(run.samples.rows(), 77, 4u));
+  const RunProcessor q = processed(full, test::random_cuts(run.samples.rows(), 77, 4u));
+  EXPECT_TRUE(p.filter().matrix() == q.filter().matrix());
+  for (std::size_t m = 0; m < p.model_count(); ++m) {
+    const double decimated = static_cast<double>(p.estimates()[m].group_rows.at(0));
+    const double every = static_cast<double>(q.estimates()[m].group_rows.at(0));
+    EXPECT_NEAR(decimated, every / 5.0, 4.0) << p.estimates()[m].model;  // +-1 per segment
+  }
+  test::expect_input_error(
+      [&] {
+        RunAnnouncement bad = full.announcement;
+        bad.preprocessing.odmf = 0;
+        RunProcessor r(bad);
+      },
+      {"odmf"});
+}
+
+// clutch_slip's mask reads 0.4 s around each row (model::Model::reach): every chunking gives the
+// same rows (the same count, estimates to rounding) as one chunk and as the offline path, and a
+// restore anywhere continues bit for bit. With only the least context (3 back, 1 ahead) the mask
+// saw the stuck samples of the current window only, and the rows depended on the chunking.
+TEST(RunProcessor, RowsThatReadFarAroundTheirSampleDoNotDependOnTheChunking) {
+  const TestRun run = test::make_clutch_run();
+  const RunProcessor one = processed(run, {run.samples.rows()});
+  ASSERT_NE(one.groups(0), nullptr);
+  EXPECT_GT(one.groups(0)->group(0).row_count(), 300u);
+  for (const auto& [largest, seed] : {std::pair{Eigen::Index{1}, 1u},
+                                      {Eigen::Index{13}, 2u},
+                                      {Eigen::Index{90}, 3u},
+                                      {Eigen::Index{1000}, 4u}}) {
+    const RunProcessor p = processed(run, test::random_cuts(run.samples.rows(), largest, seed));
+    EXPECT_LT(estimate_difference(p.estimates(), one.estimates()), 1e-12) << "chunks up to " << largest;
+  }
+  const double offline = estimate_difference(one.estimates(), offline_estimates(run, one));
+  EXPECT_LT(offline, 1e-6);
+  const std::vector<Eigen::Index> sizes = test::random_cuts(run.samples.rows(), 60, 8u);
+  const RunProcessor whole = processed(run, sizes);
+  for (const std::size_t cut : {std::size_t{1}, sizes.size() / 3, sizes.size() / 2 + 1}) {
+    RunProcessor first(run.announcement);
+    feed(first, run, sizes, 0, cut);
+    RunProcessor second = RunProcessor::restore(run.announcement, first.checkpoint());
+    feed(second, run, sizes, cut);
+    second.finish();
+    expect_bit_identical(second, whole);
+    EXPECT_EQ(second.checkpoint(), whole.checkpoint()) << "cut after chunk " << cut;
+  }
 }
 
 TEST(RunProcessor, ARejectedChunkChangesNoState) {

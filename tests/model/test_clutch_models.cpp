@@ -136,6 +136,17 @@ TEST(ClutchSlip, StickMarginLeavesOutRowsNearAStuckSample) {
   EXPECT_LT(relative_error(id.value("engine_inertia"), kEngineInertia), 1e-6);
   EXPECT_LT(relative_error(id.value("coulomb_friction"), kClio.coulomb), 1e-6);
   EXPECT_LT(relative_error(id.value("viscous_friction"), kClio.viscous), 1e-6);
+  // The mask reads the margin on both sides of a row: the reach says so (a streaming caller
+  // keeps that much context), and never less than the default.
+  const model::RowReach reach = m->reach(0.01);
+  EXPECT_EQ(reach.back, 10);
+  EXPECT_EQ(reach.ahead, 10);
+  const model::RowReach fine = m->reach(0.001);
+  EXPECT_EQ(fine.back, 100);
+  EXPECT_EQ(fine.ahead, 100);
+  const auto no_margin = model::make_model("clutch_slip", {{"clutch_friction_radius", kRadius}});
+  EXPECT_EQ(no_margin->reach(0.01).back, model::RowReach{}.back);
+  EXPECT_EQ(no_margin->reach(0.01).ahead, model::RowReach{}.ahead);
 }
 
 // Borsotto §3.1 (L1469, Table 3.1): F_c = 6, F_s = 6.3, v_s = 0.5, sigma_v = 0.1 N m over the

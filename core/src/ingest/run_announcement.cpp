@@ -23,8 +23,7 @@ void validate_preprocessing(const RunAnnouncement& a) {
   if (p.butterworth_order < 1 || p.butterworth_order > 8)
     reject(a, "preprocessing.butterworth_order",
            std::to_string(p.butterworth_order) + " is outside 1..8");
-  if (p.cutoff_hz == 0.0 && p.odmf < 1)
-    reject(a, "preprocessing.odmf", std::to_string(p.odmf) + " must be >= 1");
+  if (p.odmf < 1) reject(a, "preprocessing.odmf", std::to_string(p.odmf) + " must be >= 1");
   const double fc = p.cutoff(a.sample_rate_hz);
   if (!(fc > 0.0 && fc < 0.5 * a.sample_rate_hz))
     reject(a, "preprocessing.cutoff_hz",

@@ -32,11 +32,12 @@ struct ModelRun {
   std::string note;
 };
 
-// Rows of one model built on one ready window, and which of them are new.
+// Rows of one model built on one ready window, and which of them to fold: new (not context,
+// not look-ahead) and on the decimation grid.
 struct FoldJob {
   std::size_t model;
   std::vector<model::GroupRows> rows;
-  std::vector<std::pair<Eigen::Index, Eigen::Index>> ranges;  // first row, count per group
+  std::vector<std::vector<Eigen::Index>> selected;  // per group, rows of `rows`, increasing
 };
 
 // Every channel a model reads: its own, and the enabled effects'.
@@ -94,6 +95,7 @@ struct RunProcessor::Impl {
   std::vector<std::pair<std::string, std::string>> derived;  // name, unit
   detail::Layout layout;
   std::vector<ModelRun> models;
+  model::RowReach reach;
   std::optional<detail::SegmentStream> segment;
   RunCounters counters;
   std::uint64_t next_sequence = 0;
@@ -123,7 +125,14 @@ RunProcessor::Impl::Impl(RunAnnouncement a, ChunkLimits l)
     built.push_back(model::make_model(spec.model, spec.constants));
   plan_derived();
   plan_layout();
-  segment.emplace(sos, layout, period, announcement.preprocessing.filter_tolerance);
+  // Every row gets the context and look-ahead its model reads (e.g. a clutch mask over the
+  // filter's window), so it is the row of a whole-segment call whatever the chunking.
+  for (const auto& m : built) {
+    const model::RowReach r = m->reach(period);
+    reach.back = std::max(reach.back, r.back);
+    reach.ahead = std::max(reach.ahead, r.ahead);
+  }
+  segment.emplace(sos, layout, period, announcement.preprocessing.filter_tolerance, reach);
   plan_models();
 }
 
@@ -189,17 +198,25 @@ model::ChannelSet RunProcessor::Impl::channel_set(
 
 void RunProcessor::Impl::collect(detail::SegmentStream& seg, bool at_end, RunCounters& c,
                                  std::vector<FoldJob>& jobs) const {
+  const auto decimation = static_cast<std::uint64_t>(announcement.preprocessing.odmf);
   const detail::ReadyRows ready = seg.ready(at_end);
   if (ready.new_count == 0) return;
   const model::ChannelSet set = channel_set(ready.rows);
   for (std::size_t m = 0; m < models.size(); ++m) {
     if (!models[m].model) continue;
     FoldJob job{m, models[m].model->rows(set, models[m].spec.effects), {}};
-    // Rows of the context (already folded) and of the look-ahead (not final) are left out.
+    // Rows of the context (already folded) and of the look-ahead (not final) are left out, and
+    // so are the samples off the decimation grid: the run's grid index decides, not where a
+    // chunk or a filter block begins.
     for (const model::GroupRows& g : job.rows) {
       const auto first = std::lower_bound(g.samples.begin(), g.samples.end(), ready.first_new);
       const auto last = std::lower_bound(first, g.samples.end(), ready.first_new + ready.new_count);
-      job.ranges.emplace_back(first - g.samples.begin(), last - first);
+      std::vector<Eigen::Index>& keep = job.selected.emplace_back();
+      for (auto it = first; it != last; ++it) {
+        const std::uint64_t grid =
+            seg.start_index() + static_cast<std::uint64_t>(ready.first_index + *it);
+        if (grid % decimation == 0) keep.push_back(it - g.samples.begin());
+      }
     }
     jobs.push_back(std::move(job));
   }
@@ -224,10 +241,16 @@ void RunProcessor::Impl::end_segment(detail::SegmentStream& seg, RunCounters& c,
 void RunProcessor::Impl::fold(const std::vector<FoldJob>& jobs) {
   for (const FoldJob& job : jobs)
     for (std::size_t g = 0; g < job.rows.size(); ++g) {
-      const auto [first, count] = job.ranges[g];
-      if (count == 0) continue;
-      models[job.model].groups->fold(g, job.rows[g].W.middleRows(first, count),
-                                     job.rows[g].y.segment(first, count));
+      const std::vector<Eigen::Index>& keep = job.selected[g];
+      if (keep.empty()) continue;
+      const model::GroupRows& rows = job.rows[g];
+      if (keep.back() - keep.front() + 1 == static_cast<Eigen::Index>(keep.size())) {
+        const auto count = static_cast<Eigen::Index>(keep.size());
+        models[job.model].groups->fold(g, rows.W.middleRows(keep.front(), count),
+                                       rows.y.segment(keep.front(), count));
+      } else {
+        models[job.model].groups->fold(g, rows.W(keep, Eigen::all), rows.y(keep));
+      }
     }
 }
 

@@ -28,14 +28,14 @@ Eigen::Index get_index(ByteReader& r, const char* field) {
 }  // namespace
 
 SegmentStream::SegmentStream(const signal::Sos& sos, Layout layout, double sample_period,
-                             double tolerance)
+                             double tolerance, model::RowReach reach)
     : layout_(std::move(layout)),
+      reach_{std::max(reach.back, kReachBack), std::max(reach.ahead, kReachAhead)},
       filter_(sos, static_cast<Eigen::Index>(layout_.filtered.size()), tolerance) {
   if (!layout_.derived_from.empty())
     derivative_.emplace(static_cast<Eigen::Index>(layout_.derived_from.size()), sample_period);
-  const Eigen::Index usual = 2 * (filter_.delay() + 1);
-  fifo_.resize(usual, static_cast<Eigen::Index>(layout_.unfiltered.size()));
-  window_.resize(usual, layout_.width());
+  fifo_.resize(2 * (filter_.delay() + 1), static_cast<Eigen::Index>(layout_.unfiltered.size()));
+  window_.resize(usual_window(), layout_.width());
 }
 
 void SegmentStream::start(std::uint64_t start) {
@@ -98,23 +98,23 @@ void SegmentStream::reserve_window(Eigen::Index rows) {
 
 ReadyRows SegmentStream::ready(bool at_end) const {
   const Eigen::Index ready_end =
-      at_end ? derived_end_ : std::max(built_, derived_end_ - kReachAhead);
-  const Eigen::Index context = std::max(window_first_, built_ - kReachBack);
+      at_end ? derived_end_ : std::max(built_, derived_end_ - reach_.ahead);
+  const Eigen::Index context = std::max(window_first_, built_ - reach_.back);
   const Eigen::MatrixXd& w = window_;
   return {w.middleRows(context - window_first_, derived_end_ - context), built_ - context,
-          ready_end - built_};
+          ready_end - built_, context};
 }
 
 void SegmentStream::consume(Eigen::Index count) {
   built_ += count;
-  const Eigen::Index drop = std::max<Eigen::Index>(0, built_ - kReachBack - window_first_);
+  const Eigen::Index drop = std::max<Eigen::Index>(0, built_ - reach_.back - window_first_);
   if (drop == 0) return;
   const Eigen::Index keep = window_rows_ - drop;
   window_.topRows(keep) = window_.middleRows(drop, keep).eval();
   window_first_ += drop;
   window_rows_ = keep;
   // A long chunk grew the window: give the memory back so idle runs stay small.
-  const Eigen::Index usual = 2 * (filter_.delay() + 1);
+  const Eigen::Index usual = usual_window();
   if (window_.rows() > 4 * usual && keep <= usual)
     window_.conservativeResize(usual, Eigen::NoChange);
 }
@@ -178,10 +178,14 @@ void SegmentStream::load(ByteReader& r) {
                     window_.cols() == layout_.width() && window_end == filter_.samples_out() &&
                     (!derivative_ || derivative_->samples_in() == window_end) &&
                     derived_end_ == derived &&
-                    window_first_ <= std::max<Eigen::Index>(0, built_ - kReachBack) &&
+                    window_first_ <= std::max<Eigen::Index>(0, built_ - reach_.back) &&
                     built_ <= derived_end_ && fifo_.allFinite() && window_.allFinite();
   if (!fits) r.fail("segment buffers do not fit the run's layout or each other");
-  reserve_window(2 * (filter_.delay() + 1));
+  reserve_window(usual_window());
+}
+
+Eigen::Index SegmentStream::usual_window() const {
+  return 2 * (filter_.delay() + 1) + reach_.back + reach_.ahead;
 }
 
 }  // namespace dynid::ingest::detail

@@ -6,14 +6,16 @@
 // Window: rows [window_first, window_first + window_rows) of the segment, columns = the
 // announced channels then the derived ones. A row's announced columns are known once the filter
 // released it, its derived columns once the derivative did (derived_end). Rows are built for
-// [built, ready_end) with kReachBack rows of context before and, until the segment ends,
-// kReachAhead rows after; consume() then drops what no later row can reach.
+// [built, ready_end) with `reach.back` rows of context before and, until the segment ends,
+// `reach.ahead` rows after (the models' reach, at least kReachBack/kReachAhead); consume() then
+// drops what no later row can reach.
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
 #include <vector>
 
 #include "byte_codec.hpp"
+#include "dynid/model/model.hpp"
 #include "dynid/signal/derivative.hpp"
 #include "dynid/signal/streaming_zero_phase_filter.hpp"
 
@@ -29,16 +31,19 @@ struct Layout {
 };
 
 /// What the models may read now: `rows` (a block of the window) of which rows
-/// [first_new, first_new + new_count) are the ones to build.
+/// [first_new, first_new + new_count) are the ones to build; row i of `rows` is sample
+/// first_index + i of the segment.
 struct ReadyRows {
   Eigen::Block<const Eigen::MatrixXd> rows;
   Eigen::Index first_new;
   Eigen::Index new_count;
+  Eigen::Index first_index;
 };
 
 class SegmentStream {
  public:
-  SegmentStream(const signal::Sos& sos, Layout layout, double sample_period, double tolerance);
+  SegmentStream(const signal::Sos& sos, Layout layout, double sample_period, double tolerance,
+                model::RowReach reach);
 
   /// Starts a new segment at grid index `start` (forgets the previous one).
   void start(std::uint64_t start);
@@ -66,8 +71,11 @@ class SegmentStream {
  private:
   void append_final(const Eigen::MatrixXd& filtered);
   void reserve_window(Eigen::Index rows);
+  // Rows the window holds in steady state: a filter block, the context and the look-ahead.
+  Eigen::Index usual_window() const;
 
   Layout layout_;
+  model::RowReach reach_;
   signal::StreamingZeroPhaseFilter filter_;
   std::optional<signal::StreamingDerivative> derivative_;
   bool active_ = false;

@@ -1,5 +1,6 @@
 #include "dynid/model/clutch_slip.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -23,11 +24,23 @@ ClutchSlipModel::ClutchSlipModel(const Constants& constants) {
   if (stick_margin_ < 0.0) stick_margin_ = c.positive("stick_margin", "s, >= 0");
 }
 
+Eigen::Index ClutchSlipModel::margin_samples(double sample_period) const {
+  return static_cast<Eigen::Index>(std::ceil(stick_margin_ / sample_period - 1e-9));
+}
+
+RowReach ClutchSlipModel::reach(double sample_period) const {
+  RowReach r;
+  const Eigen::Index margin = margin_samples(sample_period);
+  r.back = std::max(r.back, margin);
+  r.ahead = std::max(r.ahead, margin);
+  return r;
+}
+
 std::vector<bool> ClutchSlipModel::near_stick(const ChannelSet& set) const {
   const Eigen::VectorXd& we = set["engine_speed"];
   const Eigen::VectorXd& wi = set["gearbox_input_speed"];
   const Eigen::Index n = set.samples();
-  const auto reach = static_cast<Eigen::Index>(std::ceil(stick_margin_ / set.sample_period() - 1e-9));
+  const Eigen::Index reach = margin_samples(set.sample_period());
   std::vector<bool> out(static_cast<std::size_t>(n), false);
   for (Eigen::Index k = 0; k < n; ++k) {
     if (std::abs(we(k) - wi(k)) >= min_slip_) continue;

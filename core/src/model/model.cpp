@@ -25,6 +25,10 @@ std::vector<ParameterInfo> Model::parameters_with(const std::vector<std::string>
   return out;
 }
 
+RowReach Model::reach(double) const {
+  return {};
+}
+
 bool Model::can_run_on(const ChannelSet& channels) const {
   for (const ChannelNeed& need : this->channels())
     if (!need.optional && !channels.has(need.name)) return false;

@@ -7,7 +7,8 @@
 // Contract: validate() throws InputError naming the field and the reason for an empty vehicle or
 // run id, a non-positive or non-finite sample rate, no channel, a duplicate or empty channel
 // name, a model spec without a name, a non-finite constant, preprocessing settings out of range
-// (Butterworth order outside 1..8, a cut-off not strictly inside (0, fs/2), odmf < 1, a filter
+// (Butterworth order outside 1..8, a cut-off not strictly inside (0, fs/2), odmf < 1 (also with
+// an explicit cut-off: odmf is the decimation factor of the rows), a filter
 // tolerance outside [1e-13, 1e-3]).
 //
 // encode_announcement()/decode_announcement() are an exact, versioned, checksummed binary form
@@ -33,13 +34,24 @@ struct ModelSpec {
 };
 
 /// How the server preprocesses the run (DYCARO's script_filtre; venture-2003 §4.3): every
-/// channel but the `unfiltered` ones goes through one zero-phase Butterworth low-pass, and the
-/// `d_<name>` channels the models need are its central differences. Defaults follow the
-/// source's settings (order 5; cut-off 0.8 fs / (2 odmf)).
+/// channel but the `unfiltered` ones goes through one zero-phase Butterworth low-pass, the
+/// `d_<name>` channels the models need are its central differences, and the model rows are
+/// built on every odmf-th sample ("parallel filtering/decimation"). Defaults follow the
+/// source's settings (order 5; cut-off 0.8 fs / (2 odmf), i.e. 0.8 of the decimated Nyquist
+/// frequency, so the rule and the decimation agree).
+///
+/// Why decimate: after a low-pass at f_c the samples are correlated over ~1 / (2 f_c); rows at
+/// the full rate add no information but make the reported standard deviations optimistic by
+/// about sqrt(fs / (2 f_c)) (about 3 at 100 Hz and 5 Hz: docs/ACCURACY.md). The filter and the
+/// derivatives run at the full rate (the derivative of a decimated signal would be coarser);
+/// only the rows are decimated, on the run's sample grid (index % odmf == 0).
 struct Preprocessing {
   int butterworth_order = 5;  ///< DYCARO's nbutter, 1..8
   double cutoff_hz = 0.0;     ///< -3 dB cut-off; 0 means DYCARO's rule 0.8 fs / (2 odmf)
-  int odmf = 8;               ///< DYCARO's cut-off divisor, used when cutoff_hz == 0
+  /// DYCARO's decimation factor (>= 1; 1 = a row on every sample), and the cut-off divisor
+  /// when cutoff_hz == 0. With an explicit cut-off keep fs / (2 odmf) >= cutoff_hz, or the
+  /// rows are still correlated (the std optimistic again).
+  int odmf = 8;
   /// Bound on |streamed - offline zero-phase filter| relative to max|x| (per segment).
   double filter_tolerance = 1e-10;
   /// Channels passed through as they are (delayed to stay aligned): discrete ones, which a

@@ -6,8 +6,10 @@
 // valid samples go through one StreamingZeroPhaseFilter per valid segment (all channels but the
 // announcement's `unfiltered` ones, which are delayed to stay aligned), the `d_<name>` channels
 // that the models need and the run does not measure come from a StreamingDerivative of the
-// filtered `<name>`, and each model's rows are built on the samples that became final and folded
-// into its ls::EquationGroups (one accumulator per model equation group).
+// filtered `<name>`, and each model's rows are built on the samples that became final and lie on
+// the decimation grid (run sample index % preprocessing.odmf == 0: DYCARO's decimation after
+// the zero-phase low-pass, run_announcement.hpp) and folded into its ls::EquationGroups (one
+// accumulator per model equation group).
 //
 // Segments. A gap (valid == 0) ends the current valid segment; the next valid sample starts a
 // new one with a fresh filter. Each segment is processed as the offline filter processes a whole
@@ -19,13 +21,14 @@
 //
 // Invariance. The result does not depend on how the run is cut into chunks: the streaming
 // filter's output is bit-identical for any chunking (its backward sweeps start on a grid fixed
-// by the sample index within the segment), derivatives are exact, and rows are built with
-// kReachBack samples of context and kReachAhead of look-ahead, so each row is the same bits as
-// in a one-chunk run. Only the grouping of rows into accumulator folds differs, i.e. the
-// estimates agree to rounding (extended-precision accumulators: ~1e-15 relative).
+// by the sample index within the segment), derivatives are exact, and rows are built with the
+// context and look-ahead their model reads (model::Model::reach(), at least kReachBack and
+// kReachAhead), so each row is the same bits as in a one-chunk run; which rows are folded
+// depends on the grid index only. Only the grouping of rows into accumulator folds differs,
+// i.e. the estimates agree to rounding (extended-precision accumulators: ~1e-15 relative).
 //
-// Delay: a sample's rows are folded once about filter delay() + 2 later samples are in (the
-// derivative's and the rows' look-ahead); finish() folds the rest.
+// Delay: a sample's rows are folded once about filter delay() + 1 + the models' look-ahead
+// later samples are in (the derivative's and the rows' look-ahead); finish() folds the rest.
 //
 // Checkpoints. checkpoint() is the complete state (accumulators, filter and derivative buffers,
 // the row window, counters, sequence), versioned and checksummed; restore() under the same
@@ -54,8 +57,9 @@
 
 namespace dynid::ingest {
 
-/// Row context the models may read around a sample: the dictionary's lags (3 back) and
-/// look-ahead (central difference, locked driveline's neighbour test: 1 ahead).
+/// Least row context around a sample: the dictionary's lags (3 back) and look-ahead (central
+/// difference, locked driveline's neighbour test: 1 ahead); a model that reads further says so
+/// (model::Model::reach()) and gets more.
 inline constexpr Eigen::Index kReachBack = 3;
 inline constexpr Eigen::Index kReachAhead = 1;
 

@@ -20,6 +20,11 @@
 // the reference simulator those rows took mu_c from 0.159 to 0.093 (min_slip_speed = 3 rad/s,
 // 5 Hz filter); with a margin of about 2 / cut-off they are gone. A larger min_slip_speed does
 // the same only by luck of the slip rate near lock.
+// The mask reads stick_margin on both sides of a row: reach() says so, so that a streaming
+// caller keeps that much context and look-ahead (with the default 3/1 samples of
+// ingest::RunProcessor the rule saw only stuck samples inside the current window: the rows of
+// a clutch release at the rev limit, filtered load still 1..9 kN, came in or not with the
+// chunking; mu_c -6..-23 % on launch runs longer than 40 s).
 //
 // Constants: clutch_friction_radius (m); optional stribeck_speed (rad/s; without it the
 // stribeck_friction effect is not offered), min_slip_speed (rad/s, 1e-3), stick_margin (s, 0),
@@ -59,6 +64,8 @@ class ClutchSlipModel final : public RowModel {
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override { return {"engine"}; }
   std::optional<double> stribeck_speed() const { return stribeck_speed_; }
+  /// At least stick_margin on both sides (near_stick), and the default.
+  RowReach reach(double sample_period) const override;
 
  protected:
   std::vector<EffectDefinition> effect_definitions() const override;
@@ -72,6 +79,8 @@ class ClutchSlipModel final : public RowModel {
   // and 0 below open_clamp_load.
   std::function<double(double)> clamp_load() const;
 
+  // Samples of stick_margin at this sample period.
+  Eigen::Index margin_samples(double sample_period) const;
   // Per sample: within stick_margin of a sample whose |slip| < min_slip_speed.
   std::vector<bool> near_stick(const ChannelSet& channels) const;
 

@@ -42,6 +42,14 @@ struct Effect {
   std::vector<std::string> channels;      ///< channels it needs beyond the model's own
 };
 
+/// How far from its own sample a row reads, in samples: the row at k depends on samples
+/// [k - back, k + ahead] only. A streaming caller (ingest::RunProcessor) gives every row at
+/// least that much context and look-ahead, so that each row is the one of a whole-record call.
+struct RowReach {
+  Eigen::Index back = 3;   ///< the dictionary's lags (lag1..lag3)
+  Eigen::Index ahead = 1;  ///< central differences, neighbour tests
+};
+
 struct GroupRows {
   std::string group;
   Eigen::MatrixXd W;  ///< rows x (parameters + enabled effects' parameters)
@@ -65,6 +73,12 @@ class Model {
   /// for channels that cannot give a sound estimate (constant where excitation is needed, ...).
   virtual std::vector<GroupRows> rows(const ChannelSet& channels,
                                       const std::vector<std::string>& effects = {}) const = 0;
+
+  /// The reach of a row at this sample period (s), with every effect: the default covers the
+  /// dictionary and one-sample neighbour tests; a model that reads further (a masking rule
+  /// over a time window) says so here, or a streaming caller builds its rows on a window too
+  /// short to see what the rule needs and masks by luck of the chunk boundaries.
+  virtual RowReach reach(double sample_period) const;
 
   /// All parameters with the enabled effects' parameters appended, in column order.
   std::vector<ParameterInfo> parameters_with(const std::vector<std::string>& effects) const;
