@@ -16,7 +16,11 @@
 #include <dynid/dds/conversions.hpp>
 #include <dynid/dds/topics.hpp>
 
+#include "dynid/car/candump_source.hpp"
 #include "dynid/car/chunk_builder.hpp"
+#include "dynid/car/pipeline.hpp"
+#include "dynid/car/replay.hpp"
+#include "dynid/car/vehicle_profile.hpp"
 
 extern char** environ;
 
@@ -58,6 +62,18 @@ ingest::RunAnnouncement make_announcement(const std::string& vehicle, const std:
 
 bool same_chunk(const ingest::Chunk& a, const ingest::Chunk& b) {
   return ingest::encode_chunk(a) == ingest::encode_chunk(b);
+}
+
+std::filesystem::path testcar_profile() { return source_dir() / "deploy" / "profiles" / "testcar.toml"; }
+
+std::vector<ingest::Chunk> expected_chunks(const std::filesystem::path& log, const std::string& run,
+                                           const std::filesystem::path& profile_file) {
+  const auto profile = load_vehicle_profile(profile_file);
+  std::vector<ingest::Chunk> out;
+  CarPipeline pipeline(profile, run, [&](ingest::Chunk&& c) { out.push_back(std::move(c)); });
+  CandumpSource source(log);
+  replay(source, pipeline);
+  return out;
 }
 
 TestAcker::TestAcker(const dds::Participant& participant, const std::string& vehicle)

@@ -52,6 +52,11 @@ ingest::RunAnnouncement make_announcement(const std::string& vehicle, const std:
 
 bool same_chunk(const ingest::Chunk& a, const ingest::Chunk& b);
 
+std::filesystem::path testcar_profile();
+/// The chunks the car's own data path cuts from a log (what the server must end up with).
+std::vector<ingest::Chunk> expected_chunks(const std::filesystem::path& log, const std::string& run,
+                                           const std::filesystem::path& profile_file = testcar_profile());
+
 class TestAcker {
  public:
   TestAcker(const dds::Participant& participant, const std::string& vehicle);

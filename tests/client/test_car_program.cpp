@@ -12,9 +12,6 @@
 #include <vector>
 
 #include "client_fixture.hpp"
-#include "dynid/car/candump_source.hpp"
-#include "dynid/car/pipeline.hpp"
-#include "dynid/car/replay.hpp"
 #include "dynid/car/spool.hpp"
 #include "dynid/car/vehicle_profile.hpp"
 
@@ -22,19 +19,6 @@ namespace dynid::car {
 namespace {
 
 using namespace testing;
-
-std::filesystem::path testcar_profile() { return source_dir() / "deploy" / "profiles" / "testcar.toml"; }
-
-// The chunks the car's own data path cuts from a log (what the server must end up with).
-std::vector<ingest::Chunk> expected_chunks(const std::filesystem::path& log, const std::string& run,
-                                           const std::filesystem::path& profile_file = testcar_profile()) {
-  const auto profile = load_vehicle_profile(profile_file);
-  std::vector<ingest::Chunk> out;
-  CarPipeline pipeline(profile, run, [&](ingest::Chunk&& c) { out.push_back(std::move(c)); });
-  CandumpSource source(log);
-  replay(source, pipeline);
-  return out;
-}
 
 std::vector<std::string> car_args(const ScratchDir& scratch, const std::string& run) {
   return {DYNID_CAR, "--profile", testcar_profile().string(), "--cyclone-config", loopback_options().config,
