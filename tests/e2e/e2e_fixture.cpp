@@ -219,13 +219,14 @@ bool TestCar::stream(const ingest::RunAnnouncement& announcement,
   return deliver(chunks);
 }
 
-bool TestCar::deliver(const std::vector<ingest::Chunk>& chunks, std::size_t from) {
-  if (chunks.empty()) return true;
+bool TestCar::deliver(const std::vector<ingest::Chunk>& chunks, std::size_t from, std::size_t end) {
+  end = std::min(end, chunks.size());
+  if (end == 0) return true;
   const std::string& run = chunks.front().run;
-  const auto last = static_cast<std::int64_t>(chunks.size()) - 1;
+  const auto last = static_cast<std::int64_t>(end) - 1;
   const auto deadline = std::chrono::steady_clock::now() + kPatience;
   while (std::chrono::steady_clock::now() < deadline) {
-    for (std::size_t k = from; k < chunks.size(); ++k) send(chunks[k]);
+    for (std::size_t k = from; k < end; ++k) send(chunks[k]);
     if (wait_acked(run, last, 2s)) return true;
     const auto it = latest_.find(run);
     from = it == latest_.end() ? 0 : static_cast<std::size_t>(it->second.highest_contiguous + 1);

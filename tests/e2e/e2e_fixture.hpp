@@ -97,10 +97,13 @@ class TestCar {
   /// Waits until every sequence up to `last` is acknowledged.
   bool wait_acked(const std::string& run, std::int64_t last,
                   std::chrono::milliseconds patience = kPatience);
-  /// As the car's spool does: sends the chunks, and resends those after the highest
-  /// acknowledged one while not all are acknowledged (a server that restarted, or one not yet
-  /// discovered, has not received them). True once all are acknowledged within kPatience.
-  bool deliver(const std::vector<ingest::Chunk>& chunks, std::size_t from = 0);
+  /// As the car's spool does: sends chunks[from, end), and resends those after the highest
+  /// acknowledged one while not all are acknowledged (a server that restarted or is not yet
+  /// discovered has not received them; a chunk that overtook its run's announcement on the
+  /// other topic was refused as of an unknown run). True once chunks up to end - 1 are
+  /// acknowledged within kPatience.
+  bool deliver(const std::vector<ingest::Chunk>& chunks, std::size_t from = 0,
+               std::size_t end = std::size_t(-1));
   /// announce() then deliver().
   bool stream(const ingest::RunAnnouncement& announcement, const std::vector<ingest::Chunk>& chunks);
 

@@ -37,8 +37,7 @@ TEST(E2eRestart, SigkillMidRunLosesNothingAndFoldsNothingTwice) {
   {
     ServerProcess first(server_arguments(dir), dir.file("server.log"));
     car.announce(run.announcement);
-    for (std::size_t k = 0; k < before_kill; ++k) car.send(chunks[k]);
-    ASSERT_TRUE(car.wait_acked("run-k", static_cast<std::int64_t>(before_kill) - 1)) << log_of(dir);
+    ASSERT_TRUE(car.deliver(chunks, 0, before_kill)) << log_of(dir);
     first.signal(SIGKILL);
     const auto status = first.wait(10s);
     ASSERT_TRUE(status && WIFSIGNALED(*status)) << "the server did not die of SIGKILL";
