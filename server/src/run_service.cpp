@@ -224,11 +224,18 @@ void RunService::fold_ready(const store::RunKey& key, RunState& run, const inges
     context_.store.with([&](store::Store& s) { s.mark_folded(key, after - 1); });
 }
 
+// A checkpoint only shortens a later replay: when it cannot be saved (a full disk, or a mark
+// below a damaged newer checkpoint after a rebuild from #0), the run goes on without it.
 void RunService::checkpoint(const store::RunKey& key, RunState& run) {
   const std::uint64_t through = run.processor.next_sequence() - 1;
-  const std::string state = run.processor.checkpoint();
-  context_.store.with([&](store::Store& s) { s.save_checkpoint(key, through, state); });
   run.since_checkpoint = 0;
+  try {
+    const std::string state = run.processor.checkpoint();
+    context_.store.with([&](store::Store& s) { s.save_checkpoint(key, through, state); });
+  } catch (const std::exception& e) {
+    spdlog::error("run {}: checkpoint through #{} not saved: {}", label(key), through, e.what());
+    return;
+  }
   context_.counters.add(&CounterSnapshot::checkpoints);
   record_history(key, tables_of(key.vehicle, key.run, run.processor.estimates()));
 }
