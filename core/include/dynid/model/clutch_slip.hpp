@@ -66,6 +66,8 @@ class ClutchSlipModel final : public RowModel {
   std::optional<double> stribeck_speed() const { return stribeck_speed_; }
   /// At least stick_margin on both sides (near_stick), and the default.
   RowReach reach(double sample_period) const override;
+  /// engine_torque_offset: the ECU's torque offset differs from run to run.
+  std::vector<std::string> per_run_parameters() const override { return {"engine_torque_offset"}; }
 
  protected:
   std::vector<EffectDefinition> effect_definitions() const override;

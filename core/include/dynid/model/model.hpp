@@ -80,6 +80,11 @@ class Model {
   /// short to see what the rule needs and masks by luck of the chunk boundaries.
   virtual RowReach reach(double sample_period) const;
 
+  /// Parameters that are constants of one run, not of the car (a sensor offset drawn again at
+  /// each power-up): pooled estimates eliminate them run by run before merging
+  /// (ingest/run_nuisance.hpp). Default: none.
+  virtual std::vector<std::string> per_run_parameters() const { return {}; }
+
   /// All parameters with the enabled effects' parameters appended, in column order.
   std::vector<ParameterInfo> parameters_with(const std::vector<std::string>& effects) const;
   /// True when every non-optional channel is present.
