@@ -269,7 +269,31 @@ TEST(SimScenario, CommittedScenariosRun) {
       EXPECT_GE(r.statistics.clutch_locks, 3) << "every launch ends with the clutch stuck";
       EXPECT_GT(r.statistics.slipping_time, 2.0);
     }
+    // Controlled slip never locks and slips the whole run.
+    if (sc.manoeuvre.type == ManoeuvreType::SlipControl) {
+      EXPECT_EQ(r.statistics.clutch_locks, 0) << entry.path();
+      EXPECT_GT(r.statistics.slipping_time, sc.duration - 0.01) << entry.path();
+    }
   }
+}
+
+// The actuator follows the swept slip target (within a few rad/s, never near a lock-up) and the
+// brakes hold the speed.
+TEST(SimPhysics, ControlledSlipFollowsItsSweepAndHoldsTheSpeed) {
+  const SimRun r = run(test::load_scenario_text("slip_control.toml") + kQuiet);
+  const auto we = test::column(r, "engine_speed");
+  const auto wi = test::column(r, "gearbox_input_speed");
+  const auto vx = test::column(r, "vx");
+  double low = 1e9, high = -1e9;
+  for (std::size_t k = 100; k < we.size(); ++k) {
+    low = std::min(low, we[k] - wi[k]);
+    high = std::max(high, we[k] - wi[k]);
+    EXPECT_NEAR(vx[k], r.scenario.manoeuvre.speed, 0.2) << "sample " << k;
+  }
+  EXPECT_GT(low, 0.5 * r.scenario.manoeuvre.slip_min);
+  EXPECT_LT(low, 1.2 * r.scenario.manoeuvre.slip_min);
+  EXPECT_GT(high, 0.9 * r.scenario.manoeuvre.slip_max);
+  EXPECT_LT(high, 1.2 * r.scenario.manoeuvre.slip_max);
 }
 
 TEST(SimScenario, TyposAreRejectedWithTheirPlace) {

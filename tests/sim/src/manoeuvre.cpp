@@ -11,7 +11,7 @@
 namespace dynid::sim {
 namespace {
 
-constexpr std::array<std::pair<const char*, ManoeuvreType>, 8> kTypes{{
+constexpr std::array<std::pair<const char*, ManoeuvreType>, 9> kTypes{{
     {"straight", ManoeuvreType::Straight},
     {"sine_steer", ManoeuvreType::SineSteer},
     {"step_steer", ManoeuvreType::StepSteer},
@@ -20,6 +20,7 @@ constexpr std::array<std::pair<const char*, ManoeuvreType>, 8> kTypes{{
     {"acceleration", ManoeuvreType::Acceleration},
     {"coast_down", ManoeuvreType::CoastDown},
     {"launch", ManoeuvreType::Launch},
+    {"slip_control", ManoeuvreType::SlipControl},
 }};
 
 // Driver's speed loop, 1/s and 1/s^2 (a calm driver: the speed wanders a little in corners).
@@ -30,6 +31,13 @@ constexpr double kLaunchEngineGain = 0.6;
 constexpr double kLaunchBaseTorque = 40.0;
 constexpr double kStandstillSpeed = 0.05;
 constexpr double kVariationFrequency = 1.3;  // Hz of the throttle variation
+// Controlled slip: the clutch actuator's PI on the slip error, as a clutch torque (N m per
+// rad/s, N m per rad): J_e e'' = -Kp e' - Ki e, about 1 Hz and well damped for J_e ~ 0.18.
+constexpr double kSlipGain = 1.7;
+constexpr double kSlipIntegralGain = 6.5;
+// Throttle variation of the controlled slip (Hz): the clamp load follows the engine torque, so
+// the rows see several loads at each slip (separates mu from the load scale, borsotto §8.4).
+constexpr double kSlipThrottleFrequency = 0.37;
 
 }  // namespace
 
@@ -55,7 +63,10 @@ Driver::Driver(const ManoeuvreSpec& spec, const CarModel& model) : spec_(spec), 
 
 State Driver::initial_state() const {
   const double speed = spec_.type == ManoeuvreType::Launch ? 0.0 : spec_.speed;
-  return model_.initial_state(speed, gear_);
+  State s = model_.initial_state(speed, gear_);
+  // Controlled slip starts slipping at the lower target (never locked: no stick transition).
+  if (spec_.type == ManoeuvreType::SlipControl) s[kWEngine] = s[kWInput] + spec_.slip_min;
+  return s;
 }
 
 double Driver::steering(double t) const {
@@ -154,6 +165,33 @@ void Driver::accelerate(double t, const State& s, DriverInputs& in) {
   }
 }
 
+void Driver::slip_control(double t, const State& s, double step, DriverInputs& in) {
+  const auto& d = model_.car.driveline;
+  const auto& v = model_.car.vehicle;
+  in.gear = gear_;
+  in.throttle_torque = spec_.drive_torque *
+                       (1.0 + spec_.torque_variation * std::sin(2.0 * std::numbers::pi * kSlipThrottleFrequency * t));
+  // The actuator: the clutch torque that carries the requested engine torque at the target slip,
+  // corrected by a PI on the slip error, turned into a clamp load with the nominal friction of
+  // the clutch's data sheet (mu_c + mu_v slip; the PI takes whatever that gets wrong, and the
+  // engine's drag the feed-forward ignores).
+  const double target = spec_.slip_min + (spec_.slip_max - spec_.slip_min) * 0.5 *
+                                             (1.0 - std::cos(2.0 * std::numbers::pi * t / spec_.slip_period));
+  const double error = (s[kWEngine] - s[kWInput]) - target;
+  slip_integral_ += error * step;
+  const double torque = in.throttle_torque + kSlipGain * error + kSlipIntegralGain * slip_integral_;
+  const double mu = d.clutch_mu_coulomb + d.clutch_mu_viscous * target;
+  in.clamp_load = std::clamp(torque / (d.clutch_radius * mu), 0.0, d.clutch_max_clamp_load);
+  // The brakes hold the speed against what the clutch drives (feed-forward + PI on the speed).
+  const double speed_error = spec_.speed - s[kVx];
+  speed_integral_ += speed_error * step;
+  const double drive = std::max(0.0, torque) * d.ratio(gear_) / v.wheel_radius;
+  const double wanted = model_.road_load_force(s[kVx]) +
+                        v.mass * (kSpeedGain * speed_error + kSpeedIntegralGain * speed_integral_);
+  const double per_pa = 2.0 * (v.brake_gain_front + v.brake_gain_rear) / v.wheel_radius;
+  in.brake_pressure = std::max(0.0, drive - wanted) / per_pa;
+}
+
 DriverInputs Driver::command(double t, const State& s, double step) {
   DriverInputs in;
   in.gear = gear_;
@@ -167,6 +205,9 @@ DriverInputs Driver::command(double t, const State& s, double step) {
       break;  // neutral, clutch engaged, engine idling
     case ManoeuvreType::Launch:
       launch(t, s, in);
+      break;
+    case ManoeuvreType::SlipControl:
+      slip_control(t, s, step, in);
       break;
     case ManoeuvreType::Acceleration:
       accelerate(t, s, in);

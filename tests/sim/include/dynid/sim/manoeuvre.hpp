@@ -1,7 +1,12 @@
 #pragma once
 // Manoeuvres and the driver who performs them: steering, throttle, clutch, gear and brake as the
 // test driver of venture-2003 §5.3 (sine steer, step steer, spirals, lift-off) and of
-// borsotto-2008 (launches with clutch slip) would apply them, plus acceleration and coast-down.
+// borsotto-2008 (launches with clutch slip) would apply them, plus acceleration, coast-down and
+// a controlled-slip run (borsotto's "glissement pilote"): the clutch actuator holds a slip swept
+// slowly between slip_min and slip_max while the engine drives and the brakes hold the speed,
+// i.e. quasi-static slip over the range where mu_c and mu_v separate (borsotto §3.5, §8.4:
+// static points are unbiased; the viscous column needs slips over [0, 10+] rad/s), far from any
+// lock-up (no stick transition to mask).
 //
 // Contract: Driver::command() is called once per integration step, in time order; it returns the
 // inputs held over that step. The driver closes loops on what a driver sees (speed, engine
@@ -13,7 +18,9 @@
 
 namespace dynid::sim {
 
-enum class ManoeuvreType { Straight, SineSteer, StepSteer, Spiral, LiftOff, Acceleration, CoastDown, Launch };
+enum class ManoeuvreType {
+  Straight, SineSteer, StepSteer, Spiral, LiftOff, Acceleration, CoastDown, Launch, SlipControl
+};
 
 // "sine_steer" <-> ManoeuvreType::SineSteer...; parse throws InputError listing the known names.
 ManoeuvreType parse_manoeuvre_type(const std::string& name);
@@ -45,6 +52,9 @@ struct ManoeuvreSpec {
   double rev_limit = 450.0;       // launch: stop driving when the engine reaches this, rad/s
   double stop_pressure = 2.0e6;   // launch: brake pressure to stop, Pa
   double wait_time = 1.0;         // launch: standing, clutch pedal down, before each launch, s
+  double slip_min = 3.0;          // slip_control: target slip swept from here, rad/s
+  double slip_max = 40.0;         // slip_control: ... to here and back (raised cosine), rad/s
+  double slip_period = 8.0;       // slip_control: one sweep up and down, s
 };
 
 class Driver {
@@ -61,10 +71,12 @@ class Driver {
   void hold_speed(double target, const State& state, double step, DriverInputs& in);
   void launch(double time, const State& state, DriverInputs& in);
   void accelerate(double time, const State& state, DriverInputs& in);
+  void slip_control(double time, const State& state, double step, DriverInputs& in);
 
   ManoeuvreSpec spec_;
   const CarModel& model_;
   double speed_integral_ = 0.0;
+  double slip_integral_ = 0.0;  // slip_control: the actuator's integral of the slip error
   // Launch and acceleration phases.
   enum class Phase { Wait, Engage, Drive, Stop, ShiftOut, ShiftIn };
   Phase phase_ = Phase::Wait;
