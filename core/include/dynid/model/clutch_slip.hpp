@@ -45,8 +45,10 @@
 // of a standing or stopping car (clutch pedal down, large slip) keep J_e and the torque offset
 // and carry no friction column. Why: there the measured load is the sensor's noise and residual
 // zero error, which the friction columns multiply by mu(dw) at slips up to ~250 rad/s (viscous
-// term), spoiling J_e and mu_c; the true friction torque below the threshold is at most
-// mu R open_clamp_load (150 N: < 3 N m). Choose ~5 sigma of the load sensor's noise.
+// term), spoiling J_e and mu_c. The price: the true friction torque below the threshold,
+// mu(dw) R open_clamp_load, is missing from those rows: < 3 N m at small slip, but up to ~18 N m
+// in a launch's first ~40 ms at 250 rad/s (mu_v dw ~ 0.9). Choose ~5 sigma of the load sensor's
+// noise.
 // Effects: viscous_friction, stribeck_friction, engine_torque_offset (ECU torque = true - T0).
 #include <optional>
 
