@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "client_fixture.hpp"
+#include "dynid/car/chunk_file.hpp"
+#include "dynid/error.hpp"
 #include "dynid/car/spool.hpp"
 #include "dynid/car/vehicle_profile.hpp"
 
@@ -135,6 +137,42 @@ TEST(ClientProgram, AFullSpoolStopsReadingWithAClearMessage) {
   const auto pending = spool.pending_entries();
   ASSERT_EQ(pending.size(), 3U) << "what fitted is kept";
   for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(pending[i].sequence, i);
+}
+
+// --chunks-out: no server and no DDS configuration; the file holds exactly the chunks the
+// pipeline cuts from the log, in order, and a cut-off file is refused rather than half read.
+TEST(ClientProgram, ChunksOutWritesTheRunsChunksWithoutAServer) {
+  ScratchDir scratch("program-chunks-out");
+  const auto run_dir = simulated_run("step_steer", scratch);
+  const auto expected = expected_chunks(run_dir / "can.log", "file-1");
+  ASSERT_GT(expected.size(), 5U);
+  const auto file = scratch.path() / "run.chunks";
+  const auto log = scratch.path() / "car.log";
+  Child car({DYNID_CAR, "--profile", testcar_profile().string(), "--run", "file-1", "--replay",
+             (run_dir / "can.log").string(), "--fast", "--chunks-out", file.string()},
+            log);
+  EXPECT_EQ(serve_until_exit(car, nullptr), 0) << read_text(log);
+  const auto written = read_chunk_file(file);
+  ASSERT_EQ(written.size(), expected.size()) << read_text(log);
+  for (std::size_t i = 0; i < written.size(); ++i) EXPECT_TRUE(same_chunk(written[i], expected[i])) << i;
+  EXPECT_NE(read_text(log).find(std::to_string(expected.size()) + " chunks ("), std::string::npos) << read_text(log);
+
+  const std::string bytes = read_text(file);
+  { std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() - 3); }
+  EXPECT_THROW(read_chunk_file(file), InputError);
+}
+
+TEST(ClientProgram, ChunksOutNeedsASourceAndOtherwiseACycloneConfig) {
+  ScratchDir scratch("program-chunks-args");
+  const auto log = scratch.path() / "car.log";
+  Child bare({DYNID_CAR, "--profile", testcar_profile().string(), "--chunks-out",
+              (scratch.path() / "x.chunks").string()},
+             log);
+  EXPECT_EQ(serve_until_exit(bare, nullptr), 1);
+  EXPECT_NE(read_text(log).find("needs --replay or --can"), std::string::npos) << read_text(log);
+  Child no_config({DYNID_CAR, "--profile", testcar_profile().string()}, log);
+  EXPECT_EQ(serve_until_exit(no_config, nullptr), 1);
+  EXPECT_NE(read_text(log).find("--cyclone-config is required"), std::string::npos) << read_text(log);
 }
 
 }  // namespace

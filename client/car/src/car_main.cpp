@@ -6,20 +6,31 @@
 //             --replay can.log --fast [--run ID] [--spool DIR]
 //   dynid-car --profile P --cyclone-config C --can can0
 //   dynid-car --profile P --cyclone-config C          # only deliver what the spool still holds
+//   dynid-car --profile P --run R --can can0 --chunks-out run.chunks [--max-frames N]
+//   dynid-car --profile P --run R --replay can.log --fast --chunks-out run.chunks
 //
-// Exit status: 0 everything acknowledged; 1 bad arguments or input, or a failure; 2 chunks left
-// unacknowledged after --drain-timeout (they stay in the spool for the next start); 3 the spool
-// filled up and reading stopped (also with chunks left); 130 interrupted.
+// --chunks-out: no server, no DDS, no spool: the sealed chunks go to a file (chunk_file.hpp), cut
+// by the same reading code, so a live run can be compared with the replay of a log of the same
+// frames (tests/vm). Live timestamps are taken at the microsecond resolution of a candump log
+// (read_bus), which is what makes that comparison exact.
+//
+// Exit status: 0 everything acknowledged (or written); 1 bad arguments or input, or a failure; 2
+// chunks left unacknowledged after --drain-timeout (they stay in the spool for the next start); 3
+// the spool filled up and reading stopped (also with chunks left); 130 interrupted.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
+#include <cmath>
 #include <csignal>
+#include <cstdint>
+#include <cstdio>
 #include <ctime>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -28,6 +39,7 @@
 #include <dynid/error.hpp>
 
 #include "dynid/car/candump_source.hpp"
+#include "dynid/car/chunk_file.hpp"
 #include "dynid/car/delivery.hpp"
 #include "dynid/car/pipeline.hpp"
 #include "dynid/car/progress_display.hpp"
@@ -54,6 +66,8 @@ struct Options {
   std::string spool;
   double drain_timeout = 60.0;
   double ack_timeout = 5.0;
+  std::string chunks_out;
+  std::uint64_t max_frames = 0;  // live: stop after this many frames (0: only on a signal)
 };
 
 constexpr const char* kLogPattern = "dynid-car %l: %v";
@@ -100,6 +114,65 @@ void check_new_run(const Spool& spool, const std::string& vehicle, const std::st
                             " (its unacknowledged chunks are resent automatically): choose a new --run");
 }
 
+// Live timestamps at the resolution of a candump -l log (whole microseconds; the kernel gives
+// nanoseconds): a log recorded beside the live reader then replays to the very same chunks, bit
+// for bit (the resampler interpolates, so a 0.4 us difference would change the samples' low
+// bits). A microsecond is far below a CAN frame's own duration (>= 47 us at 1 Mbit/s), and a
+// double of epoch seconds resolves only ~0.24 us anyway. micros / 1e6 is the nearest double to
+// the decimal the log holds, the same value CandumpSource parses from it.
+double at_log_resolution(double seconds) {
+  return static_cast<double>(std::llround(seconds * 1e6)) / 1e6;
+}
+
+// Replays options.replay into the pipeline (finished at the end); on_progress as ReplayOptions'.
+ReplayProgress replay_log(const Options& options, CarPipeline& pipe,
+                          std::function<void(const ReplayProgress&)> on_progress) {
+  CandumpSource source(options.replay);
+  ReplayOptions ro;
+  ro.speed = options.fast ? 0.0 : options.speed;
+  ro.progress_interval = 100ms;  // also how often acknowledgements are taken while replaying
+  ro.on_progress = std::move(on_progress);
+  const ReplayProgress done = replay(source, pipe, ro);
+  spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids), {:.1f} s of log, {} chunks", done.frames,
+               source.bad_input(), done.unknown_id, done.log_seconds, done.chunks);
+  for (const auto& e : source.errors()) spdlog::warn("{}", e);
+  return done;
+}
+
+// Reads options.can live into the pipeline until a signal (or options.max_frames frames), then
+// finishes it. `service` runs about every 100 ms (acknowledgements, progress). Both the delivering
+// client and --chunks-out read the bus through this loop.
+void read_bus(const Options& options, CarPipeline& pipe, const std::function<void(const CarPipeline&)>& service) {
+  SocketCanSource source(options.can);
+  g_live.store(&source);
+  struct Unregister {
+    ~Unregister() { g_live.store(nullptr); }
+  } unregister;
+  // After the bind: a script may start sending once it sees this line.
+  spdlog::info("reading {} live", options.can);
+  dynid::can::Frame frame;
+  auto next_service = std::chrono::steady_clock::now();
+  for (;;) {
+    const NextStatus status = source.next(frame, 100ms);
+    if (status == NextStatus::End) break;
+    if (status == NextStatus::Frame) {
+      frame.timestamp = at_log_resolution(frame.timestamp);
+      pipe.on_frame(frame);
+      if (options.max_frames > 0 && source.frames() >= options.max_frames) break;
+    }
+    // No frame: the grid clock still moves (receive times are CLOCK_REALTIME), so rows leave.
+    if (status == NextStatus::Timeout)
+      pipe.idle(std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
+    if (std::chrono::steady_clock::now() >= next_service) {
+      service(pipe);
+      next_service = std::chrono::steady_clock::now() + 100ms;
+    }
+  }
+  pipe.finish();
+  spdlog::info("bus {} closed: {} frames, {} error frames, {} dropped by the kernel, {} chunks", options.can,
+               source.frames(), source.error_frames(), source.dropped(), pipe.chunks());
+}
+
 struct Session {
   const Options& options;
   const VehicleProfile& profile;
@@ -127,53 +200,26 @@ struct Session {
     });
   }
 
-  void replay_log(const std::string& run) {
-    CandumpSource source(options.replay);
+  void replay_run(const std::string& run) {
     CarPipeline pipe = pipeline(run);
-    ReplayOptions ro;
-    ro.speed = options.fast ? 0.0 : options.speed;
-    ro.progress_interval = 100ms;  // also how often acknowledgements are taken while replaying
     source_name = std::filesystem::path(options.replay).filename().string();
-    ro.on_progress = [&](const ReplayProgress& p) {
+    replay_log(options, pipe, [&](const ReplayProgress& p) {
       delivery.service(0ms);
       show(p, p.done);
       if (g_stop.load()) throw Interrupted{};
-    };
-    const ReplayProgress done = replay(source, pipe, ro);
-    spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids), {:.1f} s of log, {} chunks", done.frames,
-                 source.bad_input(), done.unknown_id, done.log_seconds, done.chunks);
-    for (const auto& e : source.errors()) spdlog::warn("{}", e);
+    });
   }
 
-  void read_bus(const std::string& run) {
-    SocketCanSource source(options.can);
-    g_live.store(&source);
-    struct Unregister {
-      ~Unregister() { g_live.store(nullptr); }
-    } unregister;
+  void read_bus_run(const std::string& run) {
     CarPipeline pipe = pipeline(run);
     source_name = "live " + options.can;
-    dynid::can::Frame frame;
-    auto next_service = std::chrono::steady_clock::now();
-    for (;;) {
-      const NextStatus status = source.next(frame, 100ms);
-      if (status == NextStatus::End) break;
-      if (status == NextStatus::Frame) pipe.on_frame(frame);
-      // No frame: the grid clock still moves (receive times are CLOCK_REALTIME), so rows leave.
-      if (status == NextStatus::Timeout)
-        pipe.idle(std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
-      if (std::chrono::steady_clock::now() >= next_service) {
-        delivery.service(0ms);
-        ReplayProgress p;
-        p.frames = pipe.mapper_stats().frames;
-        p.fraction = -1.0;
-        show(p);
-        next_service = std::chrono::steady_clock::now() + 100ms;
-      }
-    }
-    pipe.finish();
-    spdlog::info("bus {} closed: {} frames, {} error frames, {} dropped by the kernel, {} chunks", options.can,
-                 source.frames(), source.error_frames(), source.dropped(), pipe.chunks());
+    read_bus(options, pipe, [&](const CarPipeline& p) {
+      delivery.service(0ms);
+      ReplayProgress progress;
+      progress.frames = p.mapper_stats().frames;
+      progress.fraction = -1.0;
+      show(progress);
+    });
   }
 
   void read_source() {
@@ -188,8 +234,8 @@ struct Session {
     if (!options.replay.empty() && !wait_for_server(run, 3s))
       spdlog::warn("no server took the announcement within 3 s: spooling, and sending when one appears");
     try {
-      if (!options.replay.empty()) replay_log(run);
-      else read_bus(run);
+      if (!options.replay.empty()) replay_run(run);
+      else read_bus_run(run);
     } catch (const SpoolFull& e) {
       // Stop reading rather than drop anything: what is stored is still delivered below.
       spool_full = true;
@@ -223,6 +269,31 @@ struct Session {
     return delivery.drained();
   }
 };
+
+// --chunks-out: the same reading and pipeline, the chunks written to a file instead of delivered.
+int write_chunks(const Options& options) {
+  const VehicleProfile profile = load_vehicle_profile(options.profile);
+  const std::string run = options.run.empty() ? default_run_id() : options.run;
+  ChunkFileWriter writer(options.chunks_out);
+  CarPipeline pipe(profile, run, [&writer](dynid::ingest::Chunk&& chunk) { writer.write(chunk); });
+  spdlog::info("run {}/{}: {} channels at {} Hz, {} rows per chunk, chunks to {}", profile.vehicle, run,
+               profile.channels.size(), profile.rate_hz, profile.chunk_rows, options.chunks_out);
+  try {
+    if (!options.replay.empty()) {
+      replay_log(options, pipe, [](const ReplayProgress&) {
+        if (g_stop.load()) throw Interrupted{};
+      });
+    } else {
+      read_bus(options, pipe, [](const CarPipeline&) {});
+    }
+  } catch (const Interrupted&) {
+    spdlog::warn("interrupted: {} chunks written to {}", writer.chunks(), options.chunks_out);
+    return kInterrupted;
+  }
+  spdlog::info("{} chunks ({} rows, {} invalid) written to {}", writer.chunks(), pipe.resampler_stats().rows,
+               pipe.resampler_stats().invalid_rows, options.chunks_out);
+  return g_stop.load() ? kInterrupted : kOk;
+}
 
 int run(const Options& options, ProgressDisplay& display) {
   const VehicleProfile profile = load_vehicle_profile(options.profile);
@@ -267,8 +338,7 @@ int main(int argc, char** argv) {
   app.add_option("--run", o.run, "run id (default: run-<UTC time>)");
   app.add_option("--cyclone-config", o.cyclone_config,
                  "Cyclone DDS configuration: a file (deploy/cyclonedds/*.xml), or file:// URIs and XML "
-                 "fragments, comma-separated, as in CYCLONEDDS_URI")
-      ->required();
+                 "fragments, comma-separated, as in CYCLONEDDS_URI (required unless --chunks-out)");
   app.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 230));
   auto* replay_opt = app.add_option("--replay", o.replay, "replay this candump -l log")->check(CLI::ExistingFile);
   auto* can_opt = app.add_option("--can", o.can, "read this SocketCAN interface live (e.g. can0)");
@@ -276,12 +346,25 @@ int main(int argc, char** argv) {
   auto* speed_opt = app.add_option("--speed", o.speed, "replay speed (1 = real time)")
                         ->check(CLI::PositiveNumber)->needs(replay_opt);
   app.add_flag("--fast", o.fast, "replay as fast as possible")->needs(replay_opt)->excludes(speed_opt);
+  app.add_option("--chunks-out", o.chunks_out,
+                 "no server: write the run's chunks to this file (length-prefixed "
+                 "encode_chunk records) and exit");
+  app.add_option("--max-frames", o.max_frames, "live: stop after this many frames")
+      ->check(CLI::PositiveNumber)->needs(can_opt);
   app.add_option("--spool", o.spool, "spool folder (default: the profile's [spool] directory)");
   app.add_option("--drain-timeout", o.drain_timeout, "seconds to wait for the last acknowledgements")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--ack-timeout", o.ack_timeout, "seconds without acknowledgement before resending")
       ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
+  if (!o.chunks_out.empty() && o.replay.empty() && o.can.empty()) {
+    std::fprintf(stderr, "dynid-car: --chunks-out needs --replay or --can\n");
+    return kFailed;
+  }
+  if (o.chunks_out.empty() && o.cyclone_config.empty()) {
+    std::fprintf(stderr, "dynid-car: --cyclone-config is required (unless --chunks-out)\n");
+    return kFailed;
+  }
 
   // Everything on stderr, through the display so log lines never tear the progress line.
   ProgressDisplay display(stderr, isatty(STDERR_FILENO) != 0);
@@ -291,6 +374,11 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
+    if (!o.chunks_out.empty()) {
+      const int status = write_chunks(o);
+      display.finish();
+      return status;
+    }
     return run(o, display);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
