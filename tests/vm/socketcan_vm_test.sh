@@ -6,8 +6,13 @@
 # frames (ids, flags, payloads; the error frame counted, not returned) with sane kernel
 # timestamps (non-decreasing, wall-clock, paced like the log). Then: kernel filters, a time
 # limit on a silent bus and SIGTERM, each ending the dump cleanly.
+# Beside the dump, dynid-car reads the same frames live with the vehicle profile (--chunks-out);
+# on this machine the dump is replayed through the same pipeline (--replay --chunks-out), and
+# the two chunk files must be identical byte for byte: the live path cuts exactly the chunks a
+# replay of the received frames cuts (the RAV4 log and DBC are needed for this part).
 #
-#   socketcan_vm_test.sh --dump BIN --tool BIN --work DIR --cache DIR [--shared-data DIR]
+#   socketcan_vm_test.sh --dump BIN --tool BIN --car BIN --profile TOML --work DIR --cache DIR
+#                        [--shared-data DIR]
 #
 # It installs what it needs (qemu-system-x86 busybox-static cpio can-utils iproute2) and
 # downloads the kernel package the linux-image-amd64 metapackage currently depends on (exact
@@ -18,24 +23,29 @@ set -euo pipefail
 fail() { echo "socketcan_vm_test: FAIL: $*" >&2; exit 1; }
 say() { echo "socketcan_vm_test: $*"; }
 
-dump_bin="" tool_bin="" work="" cache="" shared=""
+dump_bin="" tool_bin="" car_bin="" profile="" work="" cache="" shared=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --dump) dump_bin=$2; shift 2 ;;
     --tool) tool_bin=$2; shift 2 ;;
+    --car) car_bin=$2; shift 2 ;;
+    --profile) profile=$2; shift 2 ;;
     --work) work=$2; shift 2 ;;
     --cache) cache=$2; shift 2 ;;
     --shared-data) shared=$2; shift 2 ;;
     *) fail "unknown argument $1" ;;
   esac
 done
-[ -x "$dump_bin" ] && [ -x "$tool_bin" ] && [ -n "$work" ] && [ -n "$cache" ] ||
-  fail "usage: --dump BIN --tool BIN --work DIR --cache DIR [--shared-data DIR]"
+[ -x "$dump_bin" ] && [ -x "$tool_bin" ] && [ -x "$car_bin" ] && [ -f "$profile" ] && [ -n "$work" ] &&
+  [ -n "$cache" ] ||
+  fail "usage: --dump BIN --tool BIN --car BIN --profile TOML --work DIR --cache DIR [--shared-data DIR]"
 
 readonly PACKAGES="qemu-system-x86 busybox-static cpio can-utils iproute2"
 readonly QEMU_SECONDS=120     # ~15 s on an idle machine, ~50 s on a loaded one: 120 s is a hang
 readonly LOG_SECONDS=3        # of the real log (or of a generated one)
 readonly PLAYED_IFACE=can0
+readonly CAR_RUN=vm-live      # the same run id live and replayed: it is part of every chunk
+readonly CAR_GRACE=15         # s after the dump ended for dynid-car to reach the same frame count
 
 as_root() {
   if [ "$(id -u)" -eq 0 ]; then "$@"
@@ -142,6 +152,21 @@ readonly -a EXTRA_SEND=(
 # CAN_ERR_FLAG set. The source must count it and never return it.
 readonly ERROR_SEND="20000004#0004000000000000"
 
+# The profile for the VM and the host alike: its DBC beside it, and the played frames' interface
+# (they arrive on vcan0, the log's can0 is what the profile names). Nothing else changes.
+make_car_profile() {
+  local dbc
+  dbc=$(sed -n 's/^dbc *= *"\(.*\)".*/\1/p' "$profile" | head -1)
+  [ -n "$dbc" ] || fail "no dbc = \"...\" line in $profile"
+  case "$dbc" in /*) ;; *) dbc="$(dirname "$profile")/$dbc" ;; esac
+  [ -f "$dbc" ] || fail "the DBC of $profile is not there ($dbc): the chunk comparison needs it"
+  mkdir -p "$work/car"
+  cp "$dbc" "$work/car/car.dbc"
+  sed -e 's/^dbc *= *".*"/dbc = "car.dbc"/' -e 's/^interfaces *= *\[.*\]/interfaces = ["vcan0"]/' \
+    "$profile" >"$work/car/car.toml"
+  grep -q '^interfaces = \["vcan0"\]' "$work/car/car.toml" || fail "$profile names no interfaces = [...]"
+}
+
 make_expected_log() {
   cp "$work/input.log" "$work/expected.log"
   for f in "${EXTRA_SEND[@]}"; do echo "(0.000000) $PLAYED_IFACE $f" >>"$work/expected.log"; done
@@ -154,6 +179,7 @@ write_init() {
     echo '#!/bin/busybox sh'
     echo "MODULES='${modules[*]}' EXPECTED=$expected PLAYED_IFACE=$PLAYED_IFACE"
     echo "ERROR_SEND='$ERROR_SEND' EXTRA_SEND='${EXTRA_SEND[*]}'"
+    echo "CAR_RUN=$CAR_RUN CAR_GRACE=$CAR_GRACE"
     cat <<'INIT'
 /bin/busybox --install -s /bin
 export PATH=/bin:/opt/bin LD_LIBRARY_PATH=/lib/x86_64-linux-gnu:/usr/lib/x86_64-linux-gnu
@@ -162,7 +188,7 @@ vmfail() { echo "DYNID-VM-FAIL $*"; poweroff -f; }
 ready() {
   n=0
   until grep -q "reading vcan0" "$1" 2>/dev/null; do
-    n=$((n + 1)); [ $n -gt 100 ] && { cat "$1"; vmfail "dump did not start"; }
+    n=$((n + 1)); [ $n -gt 100 ] && { cat "$1"; vmfail "$1: reader did not start"; }
     sleep 0.1
   done
 }
@@ -175,17 +201,28 @@ for m in $MODULES; do insmod /lib/modules/$m.ko || vmfail "insmod $m"; done
 ip link add dev vcan0 type vcan && ip link set vcan0 mtu 72 && ip link set up vcan0 ||
   vmfail "vcan0"
 
-# 1. The log, then the extra frames and an error frame; ends after EXPECTED frames.
+# 1. The log, then the extra frames and an error frame; ends after EXPECTED frames. dynid-car
+#    reads them too, live, and writes its chunks; stopping at the same frame count (not on a
+#    signal) leaves no silent-bus time after the last frame, which a replay could not know of.
 dynid-socketcan-dump --frames $EXPECTED --seconds 60 --output /tmp/dump.log vcan0 \
   2>/tmp/dump.err &
 dump=$!
+dynid-car --profile /test/car/car.toml --run $CAR_RUN --can vcan0 --max-frames $EXPECTED \
+  --chunks-out /tmp/live.chunks 2>/tmp/car.err &
+car=$!
 ready /tmp/dump.err
+ready /tmp/car.err
 canplayer -I /test/input.log vcan0=$PLAYED_IFACE || vmfail "canplayer"
 cansend vcan0 $ERROR_SEND || vmfail "cansend $ERROR_SEND"
 for f in $EXTRA_SEND; do cansend vcan0 "$f" || vmfail "cansend $f"; done
 wait $dump
 echo "DYNID-DUMP-STATUS $?"
 cat /tmp/dump.err
+# A car that lost frames (kernel drops) never reaches EXPECTED: stop it rather than hang.
+(sleep $CAR_GRACE; kill -TERM $car 2>/dev/null) &
+wait $car
+echo "DYNID-CAR-STATUS $?"
+cat /tmp/car.err
 
 # 2. Kernel filters: a 29-bit exact id and an 11-bit one; 0x123 sent as a 29-bit id must not
 #    pass the 11-bit filter.
@@ -209,6 +246,7 @@ echo "DYNID-TERM-STATUS $? $(grep -c . /tmp/term.log)"
 
 section DUMP /tmp/dump.log
 section FILTER /tmp/filter.log
+echo DYNID-CHUNKS-BEGIN; base64 /tmp/live.chunks; echo DYNID-CHUNKS-END
 poweroff -f
 INIT
   } >"$root/init"
@@ -229,6 +267,8 @@ build_initramfs() {
   copy_program "$(command -v canplayer)" /opt/bin/canplayer
   copy_program "$(command -v cansend)" /opt/bin/cansend
   copy_program "$dump_bin" /opt/bin/dynid-socketcan-dump
+  copy_program "$car_bin" /opt/bin/dynid-car
+  cp -r "$work/car" "$root/test/car"
   cp "$work/input.log" "$root/test/input.log"
   write_init
   (cd "$root" && find . | cpio -o -H newc --quiet | gzip -1) >"$work/initrd.gz"
@@ -280,6 +320,24 @@ run_vm() {
   check_filter_and_stops
 }
 
+# The live chunks against the replay of the dump (the frames as received, kernel timestamps).
+check_chunks() {
+  grep -E "^(DYNID-CAR-STATUS|dynid-car )" "$work/serial.txt" | grep -v "^dynid-car info: reading" || true
+  grep -q "^DYNID-CAR-STATUS 0$" "$work/serial.txt" ||
+    fail "dynid-car --can vcan0 --chunks-out failed or did not receive $expected frames in the VM"
+  grep -q "^DYNID-CHUNKS-END" "$work/serial.txt" || fail "no live chunks on the serial console"
+  section CHUNKS | base64 -d >"$work/live.chunks" || fail "the live chunks did not decode from base64"
+  "$car_bin" --profile "$work/car/car.toml" --run "$CAR_RUN" --replay "$work/dump.log" --fast \
+    --chunks-out "$work/replay.chunks" 2>"$work/replay.err" ||
+    { cat "$work/replay.err" >&2; fail "replaying $work/dump.log failed"; }
+  grep "chunks (" "$work/replay.err" || true
+  "$tool_bin" chunks "$work/live.chunks" "$work/replay.chunks" ||
+    fail "the chunks dynid-car cut live differ from the replay of the frames it received ($work/*.chunks)"
+  cmp "$work/live.chunks" "$work/replay.chunks" ||
+    fail "the chunk files differ byte for byte"
+  say "chunk files identical: $(stat -c %s "$work/live.chunks") bytes"
+}
+
 [ "$(uname -m)" = x86_64 ] || fail "needs an x86_64 host (qemu-system-x86_64 without KVM)"
 mkdir -p "$work" "$cache"
 install_tools
@@ -287,6 +345,7 @@ command -v qemu-system-x86_64 >/dev/null || fail "qemu-system-x86_64 missing aft
 get_kernel
 make_input_log
 make_expected_log
+make_car_profile
 build_initramfs
 say "initramfs $(du -h "$work/initrd.gz" | cut -f1), $played log frames + ${#EXTRA_SEND[@]} sent"
 run_vm
@@ -294,4 +353,5 @@ run_vm
 # timestamp is the guest's wall clock, which qemu's RTC sets from this machine's.
 "$tool_bin" compare "$work/expected.log" "$work/dump.log" "$played" 0.5 600 ||
   fail "the frames received in the VM differ from the frames sent (see above; $work/dump.log)"
+check_chunks
 say "PASS"

@@ -4,6 +4,7 @@
 //   vm_log_tool excerpt IN OUT SECONDS IFACE   the first SECONDS of IFACE's frames of a log
 //   vm_log_tool generate OUT SECONDS           a synthetic can0 log (when no real log is there)
 //   vm_log_tool compare EXPECTED ACTUAL TIMED MAX_DRIFT NOW_WITHIN
+//   vm_log_tool chunks LIVE REPLAYED
 //
 // compare: ACTUAL (what dynid-socketcan-dump received) must hold the frames of EXPECTED in the
 // same order with identical id, format, FD flags, RTR, length and payload; its timestamps must be
@@ -11,16 +12,22 @@
 // times are wall-clock times), and for the first TIMED frames (the ones canplayer paced) the time
 // since the first frame must match EXPECTED's within MAX_DRIFT seconds. Prints every mismatch
 // (at most 20) and a summary; exit 0 only when everything holds.
+//
+// chunks: two chunk files (dynid-car --chunks-out) must hold the same chunks: same count, and per
+// chunk the same ids, sequence, first sample index, dimensions, samples (bit for bit), validity
+// flags and checksum. Prints the first differences (at most 20) and the figures compared.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include <dynid/can/candump.hpp>
+#include <dynid/car/chunk_file.hpp>
 #include <dynid/error.hpp>
 
 namespace {
@@ -131,6 +138,48 @@ int compare(const std::string& expected_path, const std::string& actual_path, st
   return problems == 0 ? 0 : 1;
 }
 
+int compare_chunks(const std::string& live_path, const std::string& replayed_path) {
+  const auto live = dynid::car::read_chunk_file(live_path);
+  const auto replayed = dynid::car::read_chunk_file(replayed_path);
+  std::size_t problems = 0;
+  auto report = [&](const std::string& what) {
+    if (++problems <= 20) std::cout << "MISMATCH " << what << "\n";
+  };
+  if (live.size() != replayed.size())
+    report("chunk count: live " + std::to_string(live.size()) + ", replayed " + std::to_string(replayed.size()));
+  const std::size_t n = std::min(live.size(), replayed.size());
+  long long rows = 0, valid = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& a = live[i];
+    const auto& b = replayed[i];
+    const std::string at = "chunk " + std::to_string(i) + ": ";
+    if (a.vehicle != b.vehicle || a.run != b.run) report(at + "vehicle/run differ");
+    if (a.sequence != b.sequence || a.sequence != i)
+      report(at + "sequence live " + std::to_string(a.sequence) + ", replayed " + std::to_string(b.sequence));
+    if (a.first_sample_index != b.first_sample_index)
+      report(at + "first sample index live " + std::to_string(a.first_sample_index) + ", replayed " +
+             std::to_string(b.first_sample_index));
+    if (a.samples.rows() != b.samples.rows() || a.samples.cols() != b.samples.cols()) {
+      report(at + "dimensions live " + std::to_string(a.samples.rows()) + "x" + std::to_string(a.samples.cols()) +
+             ", replayed " + std::to_string(b.samples.rows()) + "x" + std::to_string(b.samples.cols()));
+      continue;
+    }
+    for (Eigen::Index r = 0; r < a.samples.rows(); ++r)
+      for (Eigen::Index c = 0; c < a.samples.cols(); ++c)
+        if (std::memcmp(&a.samples(r, c), &b.samples(r, c), sizeof(double)) != 0)
+          report(at + "row " + std::to_string(r) + " column " + std::to_string(c) + ": live " +
+                 std::to_string(a.samples(r, c)) + ", replayed " + std::to_string(b.samples(r, c)));
+    if (a.valid != b.valid) report(at + "validity flags differ");
+    if (a.checksum != b.checksum) report(at + "checksum differs");
+    rows += a.samples.rows();
+    valid += std::count(a.valid.begin(), a.valid.end(), std::uint8_t{1});
+  }
+  std::printf("compared %zu chunks (sequences 0..%zu), %lld rows (%lld valid) x %lld channels: %zu problems\n",
+              n, n == 0 ? 0 : n - 1, rows, valid,
+              n == 0 ? 0LL : static_cast<long long>(live.front().samples.cols()), problems);
+  return problems == 0 && n > 0 ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -140,11 +189,12 @@ int main(int argc, char** argv) {
     if (a.size() == 3 && a[0] == "generate") return generate(a[1], std::stod(a[2]));
     if (a.size() == 6 && a[0] == "compare")
       return compare(a[1], a[2], std::stoul(a[3]), std::stod(a[4]), std::stod(a[5]));
+    if (a.size() == 3 && a[0] == "chunks") return compare_chunks(a[1], a[2]);
   } catch (const std::exception& e) {
     std::cerr << "vm_log_tool: " << e.what() << "\n";
     return 1;
   }
   std::cerr << "usage: vm_log_tool excerpt IN OUT SECONDS IFACE | generate OUT SECONDS |"
-               " compare EXPECTED ACTUAL TIMED MAX_DRIFT NOW_WITHIN\n";
+               " compare EXPECTED ACTUAL TIMED MAX_DRIFT NOW_WITHIN | chunks LIVE REPLAYED\n";
   return 2;
 }
