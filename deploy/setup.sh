@@ -26,7 +26,8 @@ fi
 
 build_dir=${BUILD_DIR:-build}
 werror=${DYNID_WERROR:-$([ "${CI:-}" = true ] && echo ON || echo OFF)}
+mkdir -p "$build_dir"
 cmake -S . -B "$build_dir" -DDYNID_WERROR="$werror" -DDYNID_SANITIZE="${DYNID_SANITIZE:-OFF}" \
-  -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-RelWithDebInfo}" -DDYNID_BUILD_BENCHMARKS="${DYNID_BUILD_BENCHMARKS:-ON}" > "$build_dir.configure.log" 2>&1 ||
-  { cat "$build_dir.configure.log"; exit 1; }
+  -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-RelWithDebInfo}" -DDYNID_BUILD_BENCHMARKS="${DYNID_BUILD_BENCHMARKS:-ON}" \
+  > "$build_dir/configure.log" 2>&1 || { cat "$build_dir/configure.log"; exit 1; }
 cmake --build "$build_dir" -j "${JOBS:-$(nproc)}"
