@@ -118,26 +118,32 @@ void Server::Impl::accept_request(const dds::Request& request) {
     if (cached) send(*cached);  // the client did not hear the first one
     return;
   }
+  if (parsed.kind == "fleet") return dispatch_fleet(parsed, request, key);
   const std::size_t worker = vehicle ? pool.worker_of(*vehicle) : 0;
   pool.post(worker, [this, worker, parsed, request, key] {
-    dds::Reply reply;
-    try {
-      reply = execute(parsed, *services[worker]);
-    } catch (const NotFound& e) {
-      counters.add(&CounterSnapshot::requests_rejected);
-      reply = reply_to(request, dds::ReplyStatus::kNotFound, e.what());
-    } catch (const InputError& e) {
-      counters.add(&CounterSnapshot::requests_rejected);
-      reply = reply_to(request, dds::ReplyStatus::kBadRequest, e.what());
-    } catch (const std::exception& e) {
-      spdlog::error("request {}#{} failed: {}", request.client, request.correlation_id, e.what());
-      reply = reply_to(request, dds::ReplyStatus::kFailed, e.what());
-    }
-    reply.client = request.client;
-    reply.correlation_id = request.correlation_id;
-    reply_cache.finish(key, reply);
-    send(reply);
+    answer(request, key, [&] { return execute(parsed, *services[worker]); });
   });
+}
+
+void Server::Impl::answer(const dds::Request& request, const ReplyCache::Key& key,
+                          const std::function<dds::Reply()>& work) {
+  dds::Reply reply;
+  try {
+    reply = work();
+  } catch (const NotFound& e) {
+    counters.add(&CounterSnapshot::requests_rejected);
+    reply = reply_to(request, dds::ReplyStatus::kNotFound, e.what());
+  } catch (const InputError& e) {
+    counters.add(&CounterSnapshot::requests_rejected);
+    reply = reply_to(request, dds::ReplyStatus::kBadRequest, e.what());
+  } catch (const std::exception& e) {
+    spdlog::error("request {}#{} failed: {}", request.client, request.correlation_id, e.what());
+    reply = reply_to(request, dds::ReplyStatus::kFailed, e.what());
+  }
+  reply.client = request.client;
+  reply.correlation_id = request.correlation_id;
+  reply_cache.finish(key, reply);
+  send(reply);
 }
 
 }  // namespace dynid::server

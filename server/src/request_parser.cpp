@@ -24,6 +24,7 @@ const std::map<std::string, KindSpec>& kinds() {
       {"reprocess", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},
       {"base", {{"vehicle", "run", "model"}, {"format"}, {}}},
       {"status", {{}, {"format"}, {}}},
+      {"fleet", {{"model", "shared", "vehicles"}, {"format"}, {"shared"}}},
   };
   return specs;
 }

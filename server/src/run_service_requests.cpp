@@ -40,6 +40,36 @@ std::size_t model_index(const std::vector<ingest::ModelEstimate>& estimates,
   return std::string::npos;
 }
 
+// One model's groups of several runs merged group by group (the accumulator of all their rows).
+// InputError when a run does not run the model or configures it differently.
+struct MergedModel {
+  std::vector<model::ParameterInfo> parameters;
+  ls::EquationGroups groups;
+};
+
+MergedModel merge_runs(const std::vector<const ingest::RunProcessor*>& processors,
+                       const std::vector<std::string>& runs, const std::string& model,
+                       const std::string& what) {
+  std::optional<MergedModel> pool;
+  for (std::size_t r = 0; r < processors.size(); ++r) {
+    const auto estimates = processors[r]->estimates();
+    const std::size_t index = model_index(estimates, model);
+    const ls::EquationGroups* groups =
+        index == std::string::npos ? nullptr : processors[r]->groups(index);
+    if (!groups) throw InputError(what + ": model " + model + " is not run in " + runs[r]);
+    if (!pool) {
+      pool.emplace(MergedModel{estimates[index].parameters,
+                               ls::EquationGroups(groups->group(0).parameter_count(), group_names(*groups))});
+    } else if (names_of(estimates[index].parameters) != names_of(pool->parameters) ||
+               group_names(*groups) != group_names(pool->groups)) {
+      throw InputError(what + ": runs " + runs.front() + " and " + runs[r] + " configure model " +
+                       model + " differently (parameters, effects or groups)");
+    }
+    for (std::size_t g = 0; g < groups->size(); ++g) pool->groups.group(g).merge(groups->group(g));
+  }
+  return std::move(*pool);
+}
+
 std::string optional_mark(const std::optional<std::uint64_t>& mark) {
   return mark ? std::to_string(*mark) : std::string("-");
 }
@@ -86,21 +116,9 @@ EstimateTables RunService::pooled(const std::string& vehicle, const std::vector<
       out.notes.push_back(first[m].model + ": not run in " + runs.front());
       continue;
     }
-    ls::EquationGroups pool(static_cast<Eigen::Index>(first[m].parameters.size()), group_names(*base));
-    for (std::size_t r = 0; r < processors.size(); ++r) {
-      const auto estimates = processors[r]->estimates();
-      const std::size_t index = model_index(estimates, first[m].model);
-      const ls::EquationGroups* groups =
-          index == std::string::npos ? nullptr : processors[r]->groups(index);
-      if (!groups) throw InputError("pooled: model " + first[m].model + " is not run in " + runs[r]);
-      if (names_of(estimates[index].parameters) != names_of(first[m].parameters) ||
-          group_names(*groups) != group_names(*base))
-        throw InputError("pooled: runs " + runs.front() + " and " + runs[r] + " configure model " +
-                         first[m].model + " differently (parameters, effects or groups)");
-      for (std::size_t g = 0; g < groups->size(); ++g) pool.group(g).merge(groups->group(g));
-    }
+    const MergedModel pool = merge_runs(processors, runs, first[m].model, "pooled");
     try {
-      out.tables.push_back(table_of(vehicle, source, first[m].model, first[m].parameters, pool.estimate()));
+      out.tables.push_back(table_of(vehicle, source, first[m].model, first[m].parameters, pool.groups.estimate()));
     } catch (const InputError& e) {
       out.notes.push_back(first[m].model + ": " + e.what());
     }
@@ -108,6 +126,30 @@ EstimateTables RunService::pooled(const std::string& vehicle, const std::vector<
   if (model && out.tables.empty() && out.notes.empty())
     throw NotFound("pooled: run " + runs.front() + " has no model " + *model);
   publish_tables(vehicle, out);
+  return out;
+}
+
+FleetSource RunService::fleet_member(const std::string& vehicle, const std::string& model) {
+  latest_run(vehicle);  // NotFound for an unknown vehicle or one without runs
+  const auto stored = context_.store.with([&](store::Store& s) { return s.list_runs(vehicle); });
+  FleetSource out;
+  std::vector<const ingest::RunProcessor*> processors;
+  for (const auto& r : stored) {
+    if (!r.closed) continue;
+    const ingest::RunProcessor& p = load({vehicle, r.run}).processor;
+    const std::size_t index = model_index(p.estimates(), model);
+    if (index == std::string::npos || p.groups(index) == nullptr) continue;
+    out.runs.push_back(r.run);
+    processors.push_back(&p);
+  }
+  if (out.runs.empty()) {  // nothing closed yet: the latest run, open or not
+    out.runs = {stored.back().run};
+    processors = {&load({vehicle, stored.back().run}).processor};
+  }
+  MergedModel merged = merge_runs(processors, out.runs, model, "fleet: vehicle " + vehicle);
+  std::vector<ls::FleetParameter> parameters;
+  for (const auto& p : merged.parameters) parameters.push_back({p.name, p.unit});
+  out.member.emplace(ls::FleetMember{vehicle, std::move(parameters), std::move(merged.groups)});
   return out;
 }
 

@@ -2,6 +2,7 @@
 // Server::Impl: the members of the server and the dispatcher's steps (server.cpp, dispatch.cpp).
 #include <atomic>
 #include <deque>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -43,6 +44,14 @@ struct Server::Impl {
   void dispatch_chunk(const dynid_wire_Chunk& sample);
   void accept_request(const dds::Request& request);
   dds::Reply execute(const ParsedRequest& request, RunService& service);
+  /// Runs `work` and replies with its result, or with the status its exception maps to
+  /// (NotFound, InputError, anything else: FAILED); the reply is cached and sent.
+  void answer(const dds::Request& request, const ReplyCache::Key& key,
+              const std::function<dds::Reply()>& work);
+  /// A fleet request: each vehicle's accumulators are read on its own worker, the last one
+  /// to be read solves and replies (fleet_request.cpp).
+  void dispatch_fleet(const ParsedRequest& request, const dds::Request& raw,
+                      const ReplyCache::Key& key);
   std::string fleet_reply(const ParsedRequest& request);
   void send(const dds::Reply& reply);
 

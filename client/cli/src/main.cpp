@@ -126,6 +126,14 @@ int main(int argc, char** argv) {
   close_cmd->add_option("--vehicle", vehicle)->required();
   close_cmd->add_option("--run", run)->required();
   auto* status_cmd = app.add_subcommand("status", "the server's counters");
+  std::vector<std::string> shared;
+  std::string fleet_vehicles;
+  auto* fleet_cmd = app.add_subcommand(
+      "fleet", "one estimate over several vehicles: shared parameters common to all, the others per vehicle");
+  fleet_cmd->add_option("model", model, "the model, e.g. longitudinal_wheel")->required();
+  fleet_cmd->add_option("shared", shared, "parameters shared by the fleet")->required();
+  fleet_cmd->add_option("--vehicles", fleet_vehicles, "comma-separated vehicles (closed runs, else the latest)")
+      ->required();
   CLI11_PARSE(app, argc, argv);
   if (c.config.empty()) {
     std::cerr << "dynid: --cyclone-config (or DYNID_CYCLONE_CONFIG) is required, e.g. "
@@ -148,6 +156,11 @@ int main(int argc, char** argv) {
     if (*base_cmd) return request(c, "base", args({{"vehicle", vehicle}, {"run", run}, {"model", model}}));
     if (*close_cmd) return request(c, "close", args({{"vehicle", vehicle}, {"run", run}}));
     if (*status_cmd) return request(c, "status", {});
+    if (*fleet_cmd) {
+      auto a = args({{"model", model}, {"vehicles", fleet_vehicles}});
+      for (const auto& s : shared) a.push_back({"shared", s});
+      return request(c, "fleet", a);
+    }
   } catch (const dynid::cli::NoServer& e) {
     std::cerr << "dynid: " << e.what() << "\n";
     return 5;

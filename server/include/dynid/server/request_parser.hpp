@@ -11,6 +11,8 @@
 //   reprocess   vehicle*, run*, model*, effects, format         replay into a fresh processor
 //   base        vehicle*, run*, model*, format                  base-parameter report
 //   status      format                                          the server's counters
+//   fleet       model*, shared*+, vehicles*, format             fleet estimate (ls/fleet.hpp)
+// vehicles is a comma-separated list; a fleet spans the vehicles of one shard.
 // format is "text" (default) or "json"; effects is a comma-separated list.
 //
 // parse_request() throws InputError naming the request ("request alice@host/42#7") and the

@@ -36,6 +36,7 @@
 #include "dynid/dds/chunk_receipt.hpp"
 #include "dynid/dds/participant.hpp"
 #include "dynid/ingest/run_processor.hpp"
+#include "dynid/ls/fleet.hpp"
 #include "dynid/server/counters.hpp"
 #include "dynid/server/estimate_tables.hpp"
 #include "dynid/server/options.hpp"
@@ -57,6 +58,12 @@ struct ServerContext {
   ServerCounters& counters;
   const dds::Participant& participant;
   RevisionClock& revisions;
+};
+
+/// A vehicle's part of a fleet request: its model's groups merged over the runs used.
+struct FleetSource {
+  std::optional<ls::FleetMember> member;  ///< always set by RunService::fleet_member
+  std::vector<std::string> runs;
 };
 
 /// The sequence a rejection of the announcement itself carries in a ChunkAck.
@@ -82,6 +89,9 @@ class RunService {
   /// Also published on the Estimate topic (source "pool:<run>+<run>...").
   EstimateTables pooled(const std::string& vehicle, const std::vector<std::string>& runs,
                         const std::optional<std::string>& model);
+  /// A vehicle's accumulators of `model` for a fleet estimate: its closed runs that run the
+  /// model, merged; when none is closed, its latest run (open or not).
+  FleetSource fleet_member(const std::string& vehicle, const std::string& model);
   EstimateTables close(const std::string& vehicle, const std::string& run);
   EstimateTables reprocess(const std::string& vehicle, const std::string& run,
                            const std::string& model, const std::vector<std::string>& effects);
