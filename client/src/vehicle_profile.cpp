@@ -10,7 +10,7 @@
 
 #include <dynid/model/registry.hpp>
 
-#include "dynid/car/channel_catalogue.hpp"
+#include "dynid/model/channel_catalogue.hpp"
 #include "dynid/error.hpp"
 
 namespace dynid::car {
@@ -244,7 +244,7 @@ ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml
               key + ".");
   ChannelMapping m;
   m.channel = r.string(t, "name", key + ".name");
-  const auto unit = channel_unit(m.channel);
+  const auto unit = model::channel_unit(m.channel);
   if (!unit) r.fail(key + ".name", "unknown channel '" + m.channel + "' (see docs/CHANNELS.md)", t.get("name"));
   m.unit = *unit;
   m.message = r.string(t, "message", key + ".message");

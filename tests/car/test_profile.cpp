@@ -9,7 +9,7 @@
 #include <dynid/error.hpp>
 
 #include "car_test_support.hpp"
-#include "dynid/car/channel_catalogue.hpp"
+#include "dynid/model/channel_catalogue.hpp"
 #include "dynid/car/units.hpp"
 #include "dynid/car/vehicle_profile.hpp"
 
@@ -31,7 +31,7 @@ TEST(CarProfile, TestcarProfileMapsTheSimulatorsDbc) {
   EXPECT_EQ(p.chunk_rows, 100U);
   EXPECT_TRUE(p.interfaces.empty());
   EXPECT_EQ(p.spool_directory, "/var/lib/dynid/spool/dynid-testcar");
-  for (const auto& m : p.channels) EXPECT_EQ(m.unit, *channel_unit(m.channel)) << m.channel;
+  for (const auto& m : p.channels) EXPECT_EQ(m.unit, *model::channel_unit(m.channel)) << m.channel;
   // km/h -> m/s; deg/s -> rad/s; steering wheel deg -> road wheel rad over the ratio of 16.
   const auto& vx = mapping(p, "vx");
   EXPECT_DOUBLE_EQ(vx.value({0, 0, 0, 36.0}), 10.0);  // VehSpeed is signal 3 of ESP_Dynamics
@@ -80,9 +80,9 @@ TEST(CarProfile, UnitTableConvertsOnlyWithinOneQuantity) {
   EXPECT_NEAR(conversion("Nm", "N m")->apply(7.0), 7.0, 0.0);
   EXPECT_FALSE(conversion("km/h", "rad/s"));
   EXPECT_FALSE(conversion("furlong", "m"));
-  EXPECT_EQ(channel_unit("d_yaw_rate"), "rad/s^2");
-  EXPECT_EQ(channel_unit("d_susp_travel_fl"), "m/s");
-  EXPECT_FALSE(channel_unit("speed"));
+  EXPECT_EQ(model::channel_unit("d_yaw_rate"), "rad/s^2");
+  EXPECT_EQ(model::channel_unit("d_susp_travel_fl"), "m/s");
+  EXPECT_FALSE(model::channel_unit("speed"));
 }
 
 // A valid test-car profile to break one piece at a time. Its nominal file lives beside the real

@@ -1,8 +1,8 @@
-#include "dynid/car/channel_catalogue.hpp"
+#include "dynid/model/channel_catalogue.hpp"
 
 #include <map>
 
-namespace dynid::car {
+namespace dynid::model {
 namespace {
 
 constexpr const char* kCorners[] = {"fl", "fr", "rl", "rr"};
@@ -71,4 +71,4 @@ const std::vector<std::string>& channel_names() {
   return names;
 }
 
-}  // namespace dynid::car
+}  // namespace dynid::model

@@ -2,8 +2,10 @@
 
 #include <array>
 #include <cmath>
+#include <stdexcept>
 
 #include "dynid/error.hpp"
+#include "dynid/model/channel_catalogue.hpp"
 
 namespace dynid::sim {
 namespace {
@@ -26,29 +28,32 @@ Vec3 rotate_to_body(const Vec3& v, double roll, double pitch) {
   return {a[0], cr * a[1] + sr * a[2], -sr * a[1] + cr * a[2]};       // Rx^T
 }
 
-std::vector<ChannelInfo> make_catalogue() {
-  std::vector<ChannelInfo> c{{"vx", "m/s"}, {"vy", "m/s"}};
-  for (const char* w : kCornerNames) c.push_back({std::string("wheel_speed_") + w, "m/s"});
-  for (const char* n : {"ax", "ay", "az"}) c.push_back({n, "m/s^2"});
-  for (const char* n : {"roll_rate", "pitch_rate", "yaw_rate"}) c.push_back({n, "rad/s"});
-  c.insert(c.end(), {{"steer", "rad"},
-                     {"engine_speed", "rad/s"},
-                     {"engine_torque", "N m"},
-                     {"gearbox_input_speed", "rad/s"},
-                     {"gear", "-"},
-                     {"gear_ratio", "-"},
-                     {"clutch_clamp_load", "N"},
-                     {"wheel_torque", "N m"},
-                     {"brake_pressure", "Pa"},
-                     {"road_grade", "rad"},
-                     {"road_bank", "rad"}});
-  for (const char* w : kCornerNames) c.push_back({std::string("susp_travel_") + w, "m"});
-  for (const char* w : kCornerNames) c.push_back({std::string("susp_force_") + w, "N"});
+// The channels the simulator writes, in the CSV column order that true_channel_values()
+// follows. Units come from the project's one catalogue (docs/CHANNELS.md as code).
+std::vector<std::string> written_channel_names() {
+  std::vector<std::string> c{"vx", "vy"};
+  for (const char* w : kCornerNames) c.push_back(std::string("wheel_speed_") + w);
+  c.insert(c.end(), {"ax", "ay", "az", "roll_rate", "pitch_rate", "yaw_rate", "steer",
+                     "engine_speed", "engine_torque", "gearbox_input_speed", "gear", "gear_ratio",
+                     "clutch_clamp_load", "wheel_torque", "brake_pressure", "road_grade",
+                     "road_bank"});
+  for (const char* w : kCornerNames) c.push_back(std::string("susp_travel_") + w);
+  for (const char* w : kCornerNames) c.push_back(std::string("susp_force_") + w);
   for (const char* w : kCornerNames)
-    for (const char* f : {"hub_fx_", "hub_fy_", "hub_fz_"}) c.push_back({std::string(f) + w, "N"});
-  for (const char* w : kCornerNames) c.push_back({std::string("tyre_deflection_") + w, "m"});
-  for (const char* w : kCornerNames) c.push_back({std::string("tyre_force_z_") + w, "N"});
-  c.push_back({"roll", "rad"});
+    for (const char* f : {"hub_fx_", "hub_fy_", "hub_fz_"}) c.push_back(std::string(f) + w);
+  for (const char* w : kCornerNames) c.push_back(std::string("tyre_deflection_") + w);
+  for (const char* w : kCornerNames) c.push_back(std::string("tyre_force_z_") + w);
+  c.push_back("roll");
+  return c;
+}
+
+std::vector<ChannelInfo> make_catalogue() {
+  std::vector<ChannelInfo> c;
+  for (auto& name : written_channel_names()) {
+    const auto unit = model::channel_unit(name);
+    if (!unit) throw std::logic_error("simulator channel '" + name + "' is not in the catalogue");
+    c.push_back({name, *unit});
+  }
   return c;
 }
 
