@@ -83,8 +83,8 @@ TEST_F(ChunkValidation, RejectsWrongIdsAndABadChecksum) {
 }
 
 TEST(ChunkEncoding, RoundTripIsExact) {
-  test::TestRun run = test::make_run(300);
-  Chunk c = test::cut(run, 3, 1490, 60);  // spans a gap
+  test::TestRun run = test::make_run(1600);
+  Chunk c = test::cut(run, 3, 1490, 60);  // spans the gap at 1500
   c.samples(0, 0) = -0.0;
   c.samples(1, 1) = std::numeric_limits<double>::denorm_min();
   c.samples(2, 2) = std::nextafter(1.0, 2.0);

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -140,6 +141,10 @@ inline TestRun make_clutch_run(Eigen::Index n = 6000, unsigned seed = 3u) {
 /// Cuts [first, first + count) of the run into a sealed chunk.
 inline Chunk cut(const TestRun& run, std::uint64_t sequence, Eigen::Index first,
                  Eigen::Index count) {
+  if (first < 0 || count < 1 || first + count > run.samples.rows())
+    throw std::out_of_range("cut: rows [" + std::to_string(first) + ", " +
+                            std::to_string(first + count) + ") outside a run of " +
+                            std::to_string(run.samples.rows()) + " samples");
   Chunk c;
   c.vehicle = run.announcement.vehicle;
   c.run = run.announcement.run;

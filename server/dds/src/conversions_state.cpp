@@ -1,7 +1,9 @@
 // Conversions of the state and request topics: ChunkAck, Estimate, Request, Reply.
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <string>
+#include <type_traits>
 
 #include "dynid/dds/conversions.hpp"
 #include "wire_fields.hpp"
@@ -26,14 +28,22 @@ dynid_wire_ParameterStatus to_wire_status(ls::ParameterStatus status) {
   throw InputError("Estimate: unknown parameter status");
 }
 
-ls::ParameterStatus from_wire_status(dynid_wire_ParameterStatus status, const std::string& where) {
-  switch (status) {
-    case dynid_wire_IDENTIFIED: return ls::ParameterStatus::kIdentified;
-    case dynid_wire_REGROUPED: return ls::ParameterStatus::kRegrouped;
-    case dynid_wire_DEPENDENT: return ls::ParameterStatus::kDependent;
-    case dynid_wire_ELIMINATED: return ls::ParameterStatus::kEliminated;
-  }
-  throw InputError(where + ": unknown status " + std::to_string(static_cast<int>(status)));
+// A wire enum holds whatever integer the peer sent. Its bits are read as an integer before they
+// are compared: loading an out-of-range value through the enum type is undefined behaviour
+// (UBSan's -fsanitize=enum caught it on a malformed sample).
+template <typename Enum>
+long long wire_enum_value(const Enum& field) {
+  std::underlying_type_t<Enum> raw;
+  std::memcpy(&raw, &field, sizeof raw);
+  return static_cast<long long>(raw);
+}
+
+ls::ParameterStatus parameter_status_from_wire(long long raw, const std::string& where) {
+  if (raw == dynid_wire_IDENTIFIED) return ls::ParameterStatus::kIdentified;
+  if (raw == dynid_wire_REGROUPED) return ls::ParameterStatus::kRegrouped;
+  if (raw == dynid_wire_DEPENDENT) return ls::ParameterStatus::kDependent;
+  if (raw == dynid_wire_ELIMINATED) return ls::ParameterStatus::kEliminated;
+  throw InputError(where + ": unknown status " + std::to_string(raw));
 }
 
 dynid_wire_ReplyStatus to_wire_status(ReplyStatus status) {
@@ -46,14 +56,12 @@ dynid_wire_ReplyStatus to_wire_status(ReplyStatus status) {
   throw InputError("Reply: unknown status");
 }
 
-ReplyStatus from_wire_status(dynid_wire_ReplyStatus status, const std::string& where) {
-  switch (status) {
-    case dynid_wire_OK: return ReplyStatus::kOk;
-    case dynid_wire_BAD_REQUEST: return ReplyStatus::kBadRequest;
-    case dynid_wire_NOT_FOUND: return ReplyStatus::kNotFound;
-    case dynid_wire_FAILED: return ReplyStatus::kFailed;
-  }
-  throw InputError(where + ": unknown status " + std::to_string(static_cast<int>(status)));
+ReplyStatus reply_status_from_wire(long long raw, const std::string& where) {
+  if (raw == dynid_wire_OK) return ReplyStatus::kOk;
+  if (raw == dynid_wire_BAD_REQUEST) return ReplyStatus::kBadRequest;
+  if (raw == dynid_wire_NOT_FOUND) return ReplyStatus::kNotFound;
+  if (raw == dynid_wire_FAILED) return ReplyStatus::kFailed;
+  throw InputError(where + ": unknown status " + std::to_string(raw));
 }
 
 void put_parameter(dynid_wire_ParameterRow& out, const ParameterEntry& entry,
@@ -75,7 +83,7 @@ ParameterEntry get_parameter(const dynid_wire_ParameterRow& in, const std::strin
   entry.value = in.value;
   entry.standard_deviation = in.standard_deviation;
   entry.relative_std_percent = in.relative_std_percent;
-  entry.status = from_wire_status(in.status, at);
+  entry.status = parameter_status_from_wire(wire_enum_value(in.status), at);
   entry.relation = get(in.relation, at + " relation");
   return entry;
 }
@@ -208,7 +216,7 @@ Reply from_wire(const dynid_wire_Reply& sample) {
   reply.client = get(sample.client, "Reply client");
   reply.correlation_id = sample.correlation_id;
   const std::string where = "Reply " + reply.client + "#" + std::to_string(reply.correlation_id);
-  reply.status = from_wire_status(sample.status, where);
+  reply.status = reply_status_from_wire(wire_enum_value(sample.status), where);
   reply.error = get(sample.error, where + " error");
   reply.payload_format = get(sample.payload_format, where + " payload format");
   const auto payload = elements(sample.payload, dynid_wire_kMaxPayload, where + " payload");
