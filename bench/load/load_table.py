@@ -1,0 +1,60 @@
+#!/usr/bin/env python3
+"""Medians of dynid-load's JSON lines (stdin) as the tables of docs/BENCHMARKS.md ("Load").
+
+    load_table.py table DDSPERF_SAMPLES_PER_S PAYLOAD_BYTES < results.jsonl
+    load_table.py soak < results.jsonl
+"""
+import json
+import statistics
+import sys
+
+
+def med(values):
+    values = [v for v in values if v == v]  # NaN out
+    return statistics.median(values) if values else float("nan")
+
+
+def table(rows, dds_rate, dds_bytes):
+    print(f"ddsperf (pub/sub, reliable keep-all, {dds_bytes} B payload): {dds_rate:,.0f} samples/s")
+    print()
+    print("| mode | N | runs (ok) | chunks/s | rows/s ingested | rows/s folded | x ddsperf | "
+          "ack p50 / p99 ms | chunk->estimate p50 / p99 ms | lost | server CPU % (per vehicle) | "
+          "RSS MB end (per vehicle, KB) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    keys = sorted({(r["mode"], r["vehicles"]) for r in rows}, key=lambda k: (k[0], k[1]))
+    for mode, n in keys:
+        rs = [r for r in rows if r["mode"] == mode and r["vehicles"] == n]
+        ok = sum(1 for r in rs if r["status"] == 0)
+        chunks_s = med([r["chunks_acked"] / r["stream_seconds"] for r in rs if r["stream_seconds"] > 0])
+        ingest = med([r["sample_rows_acked"] / r["stream_seconds"] for r in rs if r["stream_seconds"] > 0])
+        folded = med([r["sample_rows_folded"] / r["fold_seconds"] for r in rs if r["fold_seconds"] > 0])
+        cpu = med([100 * r["server_cpu_seconds"] / r["stream_seconds"] for r in rs if r["stream_seconds"] > 0])
+        rss = med([r["server_rss_end_mb"] for r in rs])
+        rss_per = med([1024 * (r["server_rss_end_mb"] - r["server_rss_start_mb"]) / n for r in rs])
+        lost = max(r["lost"] + r["missed"] for r in rs)
+        print(f"| {mode} | {n} | {len(rs)} ({ok}) | {chunks_s:,.0f} | {ingest:,.0f} | {folded:,.0f} | "
+              f"{chunks_s / dds_rate:.3f} | {med([r['ack_p50_ms'] for r in rs]):.1f} / "
+              f"{med([r['ack_p99_ms'] for r in rs]):.1f} | {med([r['estimate_p50_ms'] for r in rs]):.1f} / "
+              f"{med([r['estimate_p99_ms'] for r in rs]):.1f} | {lost} | {cpu:.0f} ({cpu / n:.2f}) | "
+              f"{rss:.1f} ({rss_per:.0f}) |")
+
+
+def soak(rows):
+    for r in rows:
+        print(f"soak: {r['vehicles']} vehicles, {r['chunks_acked']}/{r['chunks_written']} chunks acked, "
+              f"lost {r['lost']}, missed {r['missed']}, RSS {r['server_rss_start_mb']:.1f} -> "
+              f"{r['server_rss_end_mb']:.1f} MB (peak {r['server_peak_rss_mb']:.1f}), slope after the "
+              f"first fifth {r['rss_slope_kb_per_min']:.1f} KB/min over {r['rss_samples']} samples, "
+              f"chunk->estimate p50 {r['estimate_p50_ms']:.1f} ms p99 {r['estimate_p99_ms']:.1f} ms")
+
+
+def main():
+    rows = [json.loads(line) for line in sys.stdin if line.strip()]
+    if sys.argv[1] == "table":
+        table(rows, float(sys.argv[2]), int(sys.argv[3]))
+    else:
+        soak(rows)
+
+
+if __name__ == "__main__":
+    main()
