@@ -30,12 +30,15 @@
 #include "dynid/ls/equation_groups.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/sim/outputs.hpp"
+#include "sim_product_path.hpp"
 #include "sim_test_support.hpp"
 
 namespace dynid::sim {
 namespace {
 
 using SimRun = dynid::sim::Run;
+using test::model_spec;
+using test::testcar_profile;
 
 // A coast-down is a slow decay (time constant ~1 min): the run is announced with a 1 Hz
 // cut-off instead of the profile's 5 Hz, because the regressor d_vx is a differentiated noisy
@@ -70,56 +73,6 @@ std::string scenario_text(const std::string& file) {
   return text;
 }
 
-const car::VehicleProfile& testcar_profile() {
-  static const car::VehicleProfile p = car::load_vehicle_profile(DYNID_TESTCAR_PROFILE);
-  return p;
-}
-
-// The profile's spec of a model (constants merged) with the effects and extra constants the
-// run's manoeuvre calls for.
-ingest::ModelSpec model_spec(const std::string& name, std::vector<std::string> effects,
-                             const model::Constants& extra = {}) {
-  for (const auto& m : testcar_profile().models)
-    if (m.model == name) {
-      ingest::ModelSpec s = m;
-      s.effects = std::move(effects);
-      for (const auto& [k, v] : extra) s.constants[k] = v;
-      return s;
-    }
-  ADD_FAILURE() << "the test car's profile has no model " << name;
-  return {};
-}
-
-// A simulated run's can.log replayed through the car's data path with the test car's profile;
-// every chunk goes to `sink`.
-void replay_run(const SimRun& r, const std::string& run_name, const std::function<void(ingest::Chunk&&)>& sink) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("dynid-accuracy-" + std::to_string(::getpid()) + "-" + run_name);
-  std::filesystem::create_directories(dir);
-  write_can_log(dir / "can.log", r);
-  car::CarPipeline pipeline(testcar_profile(), run_name, sink);
-  car::CandumpSource source(dir / "can.log");
-  const car::ReplayProgress progress = car::replay(source, pipeline);
-  std::filesystem::remove_all(dir);
-  EXPECT_EQ(progress.bad, 0U) << run_name;
-  EXPECT_EQ(progress.unknown_id, 0U) << run_name;
-  EXPECT_GT(progress.rows, 0U) << run_name;
-}
-
-// The run's tare (deploy/scenarios/tare.toml, same sensors: same seed) through the same path:
-// the zeros of the wheel-torque meter and the clamp-load sensor.
-ingest::ZeroCalibration tare_for(const SimRun& r) {
-  const SimRun tare = test::run(scenario_text("tare.toml"), r.seed);
-  const std::string name = "tare-" + r.scenario.name + "-" + std::to_string(r.seed);
-  ingest::ZeroCalibration zero(testcar_profile().announcement(name), {"wheel_torque", "clutch_clamp_load"});
-  replay_run(tare, name, [&](ingest::Chunk&& c) { zero.push(c); });
-  if (std::getenv("DYNID_ACCURACY_VERBOSE") != nullptr)
-    for (const auto& [channel, value] : zero.zeros())
-      std::printf("tare %s: zero %.4g, simulated offset %.4g\n", channel.c_str(), value,
-                  r.offsets[channel_index(channel)]);
-  return zero;
-}
-
 // One run through the product: tare, then can.log -> replay with the profile -> chunks ->
 // RunProcessor. Returns the run's accumulators of its one model.
 ls::EquationGroups process(const SimRun& r, const ingest::ModelSpec& spec, double cutoff_hz = 0.0) {
@@ -133,9 +86,9 @@ ls::EquationGroups process(const SimRun& r, const ingest::ModelSpec& spec, doubl
     a.preprocessing.cutoff_hz = a.preprocessing.cutoff(a.sample_rate_hz);
     a.preprocessing.odmf = std::atoi(odmf);
   }
-  if (std::getenv("DYNID_ACCURACY_NO_TARE") == nullptr) tare_for(r).apply(a);
+  if (std::getenv("DYNID_ACCURACY_NO_TARE") == nullptr) test::tare_for(r, scenario_text("tare.toml")).apply(a);
   ingest::RunProcessor processor(a);
-  replay_run(r, run_name, [&](ingest::Chunk&& c) { processor.push(c); });
+  test::replay_run(r, run_name, [&](ingest::Chunk&& c) { processor.push(c); });
   processor.finish();
   const ls::EquationGroups* g = processor.groups(0);
   if (g == nullptr) {

@@ -4,6 +4,7 @@
 #include <set>
 
 #include "byte_codec.hpp"
+#include "derived_channels.hpp"
 #include "dynid/error.hpp"
 #include "dynid/model/channel_set.hpp"
 #include "dynid/model/effects.hpp"
@@ -16,12 +17,6 @@ namespace {
 
 constexpr std::string_view kMagic = "DYNIDRPC";
 constexpr std::uint16_t kVersion = 1;
-
-// docs/CHANNELS.md: the unit of d_<name> is <name>'s per second (m/s -> m/s^2, m -> m/s).
-std::string derivative_unit(const std::string& unit) {
-  const bool per_second = unit.size() >= 2 && unit.compare(unit.size() - 2, 2, "/s") == 0;
-  return per_second ? unit + "^2" : unit + "/s";
-}
 
 struct ModelRun {
   ModelSpec spec;
@@ -145,7 +140,7 @@ void RunProcessor::Impl::plan_derived() {
       const std::string base = c.substr(2);
       if (!announced(announcement, base)) continue;
       const std::size_t col = announcement.column_of(base);
-      derived.emplace_back(c, derivative_unit(announcement.channels[col].unit));
+      derived.emplace_back(c, detail::derivative_unit(announcement.channels[col].unit));
       layout.derived_from.push_back(static_cast<Eigen::Index>(col));
     }
 }

@@ -179,6 +179,30 @@ void Accumulator::merge(const Accumulator& other) {
   effective_rows_ += other.effective_rows_;
 }
 
+Accumulator Accumulator::select_columns(const std::vector<Eigen::Index>& columns) const {
+  for (std::size_t i = 0; i < columns.size(); ++i)
+    if (columns[i] < 0 || columns[i] >= n_ || (i > 0 && columns[i] <= columns[i - 1]))
+      throw InputError("select_columns: column list must be increasing within 0.." +
+                       std::to_string(n_ - 1) + " (entry " + std::to_string(i) + " is " +
+                       std::to_string(columns[i]) + ")");
+  if (columns.empty()) throw InputError("select_columns: no column selected");
+  Accumulator out(static_cast<Eigen::Index>(columns.size()), precision_);
+  const Eigen::Index order = out.n_ + 1;
+  const Eigen::Index m = n_ + 1;  // rows of R_aug
+  ExtendedMatrix selected(m, order);
+  for (Eigen::Index j = 0; j < out.n_; ++j) selected.col(j) = r_aug_.col(columns[static_cast<std::size_t>(j)]);
+  selected.col(out.n_) = r_aug_.col(n_);
+  if (precision_ == Precision::kExtended) {
+    out.fold_extended(selected.data(), m, false);
+  } else {
+    Eigen::MatrixXd rows = selected.cast<double>();
+    out.fold_double(rows.data(), m, false);
+  }
+  out.rows_ = rows_;
+  out.effective_rows_ = effective_rows_;
+  return out;
+}
+
 void Accumulator::fold_extended(Extended* rows, Eigen::Index m, bool triangular) {
   householder_fold<Extended>(r_aug_, rows, m, triangular);
 }

@@ -42,6 +42,13 @@ BodyModel::BodyModel(const Constants& constants) {
   air_density_ = c.optional("air_density");
 }
 
+std::vector<std::string> BodyModel::measured_side() const {
+  std::vector<std::string> out;
+  for (const char* corner : kCorners)
+    for (const char* part : kWrench) out.push_back(std::string("hub_") + part + "_" + corner);
+  return out;
+}
+
 std::vector<ParameterInfo> BodyModel::parameters() const {
   return {parameter("XX", "kg m^2", "roll inertia at C"),
           parameter("XY", "kg m^2", "inertia product at C"),

@@ -21,6 +21,10 @@ std::vector<std::string> KinematicModel::groups() const {
   return {axis_ == Axis::kLongitudinal ? "longitudinal" : "lateral"};
 }
 
+std::vector<std::string> KinematicModel::measured_side() const {
+  return {axis_ == Axis::kLongitudinal ? "ax" : "ay"};
+}
+
 std::vector<ParameterInfo> KinematicModel::parameters() const {
   return {parameter("sensor_scale", "-", "accelerometer gain over speed scale", 1.0),
           parameter("sensor_offset", "m/s^2", "accelerometer offset", 0.0)};
@@ -33,14 +37,15 @@ std::vector<ChannelNeed> KinematicModel::channels() const {
           {"d_vy", "m/s^2"},
           {"vx", "m/s"},
           {"yaw_rate", "rad/s"},
-          {"road_bank", "rad", true}};
+          {"road_bank", "rad", true},
+          {"roll", "rad", true}};
 }
 
 std::vector<RowModel::EffectDefinition> KinematicModel::effect_definitions() const {
   const bool lon = axis_ == Axis::kLongitudinal;
   const std::string channel = lon ? "road_grade" : "road_bank";
   const double g = gravity_;
-  return {detail::one_column(
+  std::vector<EffectDefinition> out{detail::one_column(
       {lon ? effect::kRoadGrade : effect::kRoadBank,
        "gravity along the axis: g sin(" + channel + ")",
        {parameter(lon ? "grade_gain" : "bank_gain", "-", "gain on g sin(angle)", 1.0)},
@@ -49,6 +54,16 @@ std::vector<RowModel::EffectDefinition> KinematicModel::effect_definitions() con
         const Eigen::VectorXd& angle = set[channel];
         return [&angle, g](Eigen::Index k) { return g * std::sin(angle(k)); };
       })};
+  if (!lon)
+    out.push_back(detail::one_column(
+        {effect::kRollGravity, "the accelerometer rolls with the body: g sin(roll) more",
+         {parameter("roll_gravity_gain", "-", "gain on g sin(roll)", 1.0)},
+         {"roll"}},
+        [g](const ChannelSet& set) -> detail::ValueFn {
+          const Eigen::VectorXd& roll = set["roll"];
+          return [&roll, g](Eigen::Index k) { return g * std::sin(roll(k)); };
+        }));
+  return out;
 }
 
 RowModel::RowFn KinematicModel::bind(const ChannelSet& set,

@@ -30,6 +30,10 @@ std::string LongitudinalModel::name() const {
   return source_ == Source::kEngineTorque ? "longitudinal_engine" : "longitudinal_wheel";
 }
 
+std::vector<std::string> LongitudinalModel::measured_side() const {
+  return {source_ == Source::kWheelTorque ? "wheel_torque" : "engine_torque"};
+}
+
 std::vector<ParameterInfo> LongitudinalModel::parameters() const {
   return {parameter("mass", "kg", "vehicle mass (translating)"),
           parameter("SCx", "m^2", "aerodynamic drag area S Cx"),

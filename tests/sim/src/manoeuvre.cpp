@@ -146,6 +146,7 @@ void Driver::accelerate(double t, const State& s, DriverInputs& in) {
   in.throttle_torque = spec_.drive_torque *
                        (1.0 + spec_.torque_variation * std::sin(2.0 * std::numbers::pi * kVariationFrequency * t));
   in.clamp_load = d.clutch_max_clamp_load;
+  in.brake_pressure = spec_.drag_pressure * 0.5 * (1.0 - std::cos(2.0 * std::numbers::pi * t / spec_.drag_period));
   if (phase_ == Phase::Drive && s[kWEngine] >= spec_.shift_speed && gear_ < d.gear_count()) {
     phase_ = Phase::ShiftOut;
     phase_start_ = t;

@@ -87,7 +87,8 @@ void read_manoeuvre(const Reader& r, const toml::table& t, ManoeuvreSpec& m) {
       {"shift_time", &m.shift_time}, {"launch_engine_speed", &m.launch_engine_speed},
       {"engagement_time", &m.engagement_time}, {"rev_limit", &m.rev_limit},
       {"stop_pressure", &m.stop_pressure}, {"wait_time", &m.wait_time}, {"slip_min", &m.slip_min},
-      {"slip_max", &m.slip_max}, {"slip_period", &m.slip_period}};
+      {"slip_max", &m.slip_max}, {"slip_period", &m.slip_period},
+      {"drag_pressure", &m.drag_pressure}, {"drag_period", &m.drag_period}};
   for (const auto& [k, node] : t) {
     const std::string name(k.str());
     const std::string key = "manoeuvre." + name;
@@ -159,6 +160,8 @@ void check(const Reader& r, const Scenario& s) {
   if (!(m.slip_min > 0.0)) r.fail("manoeuvre.slip_min", "must be > 0");
   if (!(m.slip_max >= m.slip_min)) r.fail("manoeuvre.slip_max", "must be >= slip_min");
   if (!(m.slip_period > 0.0)) r.fail("manoeuvre.slip_period", "must be > 0");
+  if (!(m.drag_pressure >= 0.0)) r.fail("manoeuvre.drag_pressure", "must be >= 0");
+  if (!(m.drag_period > 0.0)) r.fail("manoeuvre.drag_period", "must be > 0");
   const auto& v = s.car.vehicle;
   if (!(v.mass > 2.0 * (v.unsprung_mass_front + v.unsprung_mass_rear)))
     r.fail("vehicle.mass", "must exceed the unsprung masses");

@@ -68,6 +68,14 @@ class Accumulator {
   /// union of both row sets, whatever order they were folded in.
   void merge(const Accumulator& other);
 
+  /// The accumulator of the same rows restricted to the regressor `columns` (strictly
+  /// increasing, each < parameter_count(); y stays the measured side): R_aug of [W(:, columns) y]
+  /// by re-triangularizing the selected columns of R_aug, which have the same Gram matrix.
+  /// Row counts are kept. This is how the residual loop compares a model with and without a
+  /// candidate effect on the same rows from one accumulator of [W | C | y]. InputError for an
+  /// empty, unordered or out-of-range column list.
+  Accumulator select_columns(const std::vector<Eigen::Index>& columns) const;
+
   /// Exponential forgetting: every row folded so far gets weight lambda (0 < lambda <= 1),
   /// i.e. R_aug *= sqrt(lambda) and the effective row count *= lambda.
   void forget(double lambda);

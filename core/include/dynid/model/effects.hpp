@@ -43,6 +43,9 @@ inline constexpr const char* kSteerOffset = "steer_offset";          ///< sensor
 inline constexpr const char* kSlipOffset = "slip_offset";
 /// Body roll acceleration in the lateral and yaw rows (masses not rolling, J_xz).
 inline constexpr const char* kRollAcceleration = "roll_acceleration";
+/// A body-fixed accelerometer rolls with the body: it reads g sin(roll) more than the road-plane
+/// lateral acceleration (`roll`: body roll to the road).
+inline constexpr const char* kRollGravity = "roll_gravity";
 inline constexpr const char* kForceOffset = "hub_force_offset";      ///< sensor offsets
 inline constexpr const char* kDictionaryPrefix = "dict:";
 }  // namespace effect

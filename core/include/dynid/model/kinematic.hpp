@@ -7,7 +7,9 @@
 //   axis kLongitudinal ("kinematic_longitudinal"), group "longitudinal":
 //       ax = s d_vx + o          (+ g sin(grade), effect road_grade)
 //   axis kLateral ("kinematic_lateral"), group "lateral":
-//       ay = s (d_vy + r vx) + o (+ g sin(bank), effect road_bank)
+//       ay = s (d_vy + r vx) + o (+ g sin(bank), effect road_bank;
+//                                 + g sin(roll), effect roll_gravity: the body-fixed
+//                                 accelerometer rolls with the body)
 //
 // Parameters [sensor_scale s (-), sensor_offset o (m/s^2)]: s = accelerometer gain / speed
 // scale (a wheel-radius error scales d_vx), a priori 1; o a priori 0. The grade (bank) effect's
@@ -27,6 +29,7 @@ class KinematicModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override;
+  std::vector<std::string> measured_side() const override;
 
  protected:
   std::vector<EffectDefinition> effect_definitions() const override;

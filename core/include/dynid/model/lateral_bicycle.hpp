@@ -58,6 +58,7 @@ class LateralBicycleModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override { return {"lateral", "yaw"}; }
+  std::vector<std::string> measured_side() const override { return {"ay"}; }
 
  protected:
   std::vector<EffectDefinition> effect_definitions() const override;

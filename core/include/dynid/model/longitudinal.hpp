@@ -52,6 +52,7 @@ class LongitudinalModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override { return {"longitudinal"}; }
+  std::vector<std::string> measured_side() const override;
 
  protected:
   std::vector<EffectDefinition> effect_definitions() const override;

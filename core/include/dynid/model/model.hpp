@@ -85,6 +85,11 @@ class Model {
   /// (ingest/run_nuisance.hpp). Default: none.
   virtual std::vector<std::string> per_run_parameters() const { return {}; }
 
+  /// The channels the measured side y is made of (e.g. the torque or force sensor). The
+  /// residual loop offers no dictionary effect over them: a column made of y itself (or of its
+  /// lag) "explains" any residual without meaning anything. Default: none.
+  virtual std::vector<std::string> measured_side() const { return {}; }
+
   /// All parameters with the enabled effects' parameters appended, in column order.
   std::vector<ParameterInfo> parameters_with(const std::vector<std::string>& effects) const;
   /// True when every non-optional channel is present.

@@ -55,6 +55,11 @@ struct ManoeuvreSpec {
   double slip_min = 3.0;          // slip_control: target slip swept from here, rad/s
   double slip_max = 40.0;         // slip_control: ... to here and back (raised cosine), rad/s
   double slip_period = 8.0;       // slip_control: one sweep up and down, s
+  // Acceleration: the driver rides the brake pedal, a light pressure rising and falling between
+  // 0 and drag_pressure over drag_period (0: foot off the pedal). A dragging brake whose
+  // pressure the car measures but a profile that masks only hard braking does not model.
+  double drag_pressure = 0.0;     // Pa
+  double drag_period = 6.0;       // s
 };
 
 class Driver {

@@ -1,0 +1,53 @@
+#pragma once
+// RecordedRun: a whole stored run (its announcement and every chunk, in order) and its offline
+// preprocessing, for the analyses that need the rows themselves rather than the accumulators:
+// the residual time series and the candidate-effect screen (residual/), and reports.
+//
+// assemble_run() lays the chunks end to end on the run's sample grid. Contract: chunks are
+// validated against the announcement (validate_chunk) and must be the sequences 0, 1, 2, ...
+// with contiguous sample indices; otherwise InputError naming the chunk and the reason.
+//
+// preprocess_offline() is DYCARO's script_filtre on the whole record, as RunProcessor's
+// documentation defines it: every valid segment longer than the filter's padlen is low-passed
+// whole (zero-phase, the announcement's Butterworth; the `unfiltered` channels pass through),
+// and d_<name> is the central difference of the filtered <name> for EVERY announced channel the
+// run does not measure itself (so that any candidate effect can read it). Segments too short to
+// filter are left out, as RunProcessor leaves them out. The streamed path equals this one to the
+// announcement's filter tolerance (tests/ingest: "MatchesTheFullyOfflinePath...").
+//
+// Rows are decimated by the caller: a row at segment sample i is kept when
+// (segment.first + i) % odmf == 0 (on_decimation_grid()).
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "dynid/ingest/chunk.hpp"
+#include "dynid/ingest/run_announcement.hpp"
+#include "dynid/model/channel_set.hpp"
+
+namespace dynid::ingest {
+
+struct RecordedRun {
+  RunAnnouncement announcement;
+  std::uint64_t first_sample_index = 0;  ///< run grid index of samples.row(0)
+  Eigen::MatrixXd samples;               ///< grid samples x announced channels
+  std::vector<std::uint8_t> valid;       ///< one flag per sample
+};
+
+RecordedRun assemble_run(RunAnnouncement announcement, const std::vector<Chunk>& chunks,
+                         const ChunkLimits& limits = {});
+
+struct PreprocessedSegment {
+  Eigen::Index first = 0;  ///< run grid index of the segment's first sample
+  model::ChannelSet channels;
+};
+
+std::vector<PreprocessedSegment> preprocess_offline(const RecordedRun& run);
+
+/// True when the row at segment sample `i` lies on the run's decimation grid.
+inline bool on_decimation_grid(const PreprocessedSegment& segment, Eigen::Index i, int odmf) {
+  return (segment.first + i) % odmf == 0;
+}
+
+}  // namespace dynid::ingest

@@ -1,0 +1,46 @@
+#pragma once
+// EffectComparison: "add effect" and the before/after report (DESIGN.md "Residual loop" step
+// 3): the model as declared and the model with the effect, each fitted on its own rows of the
+// whole run (model_fit.hpp); their residual RMS and relative norms in sample and held out; the
+// parameters with standard deviations before and after; and, where the truth is known (a
+// simulated run, a weighed car), the parameter errors before and after.
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dynid/residual/effect_screen.hpp"
+#include "dynid/residual/model_fit.hpp"
+
+namespace dynid::residual {
+
+struct ParameterChange {
+  std::string name;
+  std::string unit;
+  double before = 0.0;  ///< NaN when the parameter is the added effect's (or not identifiable)
+  double std_before = 0.0;
+  double after = 0.0;
+  double std_after = 0.0;
+  std::optional<double> truth;
+  double error_before_percent() const;  ///< NaN without truth
+  double error_after_percent() const;
+};
+
+struct EffectComparison {
+  std::string effect;
+  ModelFit before;
+  ModelFit after;
+  std::vector<ParameterChange> parameters;  ///< the model's, then the effect's
+  /// Relative drops (1 - after/before) of the weighted RMS, in sample and held out.
+  double in_sample_drop() const;
+  double held_out_drop() const;
+};
+
+/// `truth`: parameter name -> true value, for the parameters where it is known.
+EffectComparison compare_effect(const model::Model& model, const std::vector<std::string>& declared,
+                                const std::string& effect,
+                                const std::vector<ingest::PreprocessedSegment>& run,
+                                double sample_rate_hz, int odmf, const FitOptions& options = {},
+                                const std::map<std::string, double>& truth = {});
+
+}  // namespace dynid::residual

@@ -1,0 +1,89 @@
+#pragma once
+// EffectScreen: which effect does a model lack? (DESIGN.md "Residual loop" step 2; the
+// "missing effect" cases of venture-2003 §7 and borsotto-2008 §5, made a tool.)
+//
+// Candidates: the model's physical candidate effects (Model::candidate_effects()), the road
+// profile (road_profile.hpp) when vx is present, and the generic dictionary (x, x^2, |x|x,
+// sgn x, d/dt, lags 1-3; model/effects.hpp) over the run's channels that the model's physics
+// reads (its own channels and its candidate effects'), never over its measured side
+// (Model::measured_side()). Why not every channel by default: a car carries other sensors of the
+// very forces a model explains (the wheel torque downstream of a slipping clutch, suspension
+// and tyre loads that follow the lateral acceleration); terms over them fit well and mean
+// nothing (measured on the reference simulator: they were "significant" in every run with no
+// missing effect). dictionary_all_channels widens the dictionary to every announced channel,
+// for a hunt where proxies are welcome. Effects already enabled are not candidates; a
+// candidate whose channels the run lacks is listed with the reason.
+//
+// Test of a candidate C (the added-variable test, on the candidate's own rows): the rows of
+// [W | C | y] are folded into one accumulator set per cross-validation fold; the model without
+// C on the same rows comes from the same accumulators (Accumulator::select_columns), so the
+// screen needs accumulators only and could run live on the server. Reported: the in-sample drop
+// of the weighted residual sum of squares and its F statistic, and the held-out weighted RMS
+// before and after with the number of folds it improves.
+//
+// Significant: the held-out weighted RMS drops by at least min_held_out_drop AND every fold
+// improves. The in-sample F is reported, not used: with autocorrelated rows it is large for
+// nearly anything.
+//
+// Ranking, in tiers: significant physical effects, then a significant road profile, then
+// significant dictionary terms, then the rest; by held-out drop within a tier (ties within 1e-9
+// by kind). Why tiers: a physical effect has a meaning and parameters an engineer can use; the
+// dictionary exists for effects nobody listed, and it also holds proxies (another sensor of the
+// same force: the wheel torque for a clutch's friction torque, suspension forces for a roll
+// angle) that fit well and mean little. The report lists the dictionary terms that do better
+// than the chosen effect; if they stay significant after it is added, the loop goes on.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "dynid/ingest/recorded_run.hpp"
+#include "dynid/model/model.hpp"
+#include "dynid/residual/model_fit.hpp"
+
+namespace dynid::residual {
+
+enum class CandidateKind { kPhysics, kRoadProfile, kDictionary };
+const char* kind_name(CandidateKind kind);
+
+struct CandidateScore {
+  std::string effect;
+  std::string description;
+  CandidateKind kind = CandidateKind::kDictionary;
+  std::size_t columns = 0;        ///< parameters the effect adds
+  std::uint64_t rows = 0;         ///< rows of the model with the effect
+  bool evaluated = false;
+  std::string note;               ///< why not evaluated (missing channel, no row...)
+  double in_sample_drop = 0.0;    ///< 1 - SS_after / SS_before (weighted, same rows)
+  double f_statistic = 0.0;
+  double held_out_rms_before = 0.0;  ///< weighted
+  double held_out_rms_after = 0.0;
+  double held_out_drop = 0.0;        ///< 1 - after / before
+  int folds_improved = 0;
+  int folds = 0;
+  bool significant = false;
+};
+
+struct ScreenOptions {
+  FitOptions fit;
+  double min_held_out_drop = 0.05;
+  bool dictionary = true;
+  bool dictionary_all_channels = false;  ///< see above
+  bool road_profile = true;
+  /// When not empty, only these candidates (any kind) are tested.
+  std::vector<std::string> only;
+};
+
+struct ScreenResult {
+  ModelFit fit;  ///< the model as declared
+  std::vector<CandidateScore> candidates;  ///< ranked; not evaluated ones last
+  /// The best significant candidate, or nullptr when nothing is significant.
+  const CandidateScore* best() const;
+  /// One sentence: what explains the residual, or that nothing significant was found.
+  std::string verdict() const;
+};
+
+ScreenResult screen_effects(const model::Model& model, const std::vector<std::string>& declared,
+                            const std::vector<ingest::PreprocessedSegment>& run,
+                            double sample_rate_hz, int odmf, const ScreenOptions& options = {});
+
+}  // namespace dynid::residual

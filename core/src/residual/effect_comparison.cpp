@@ -1,0 +1,60 @@
+#include "dynid/residual/effect_comparison.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace dynid::residual {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double error_percent(double value, const std::optional<double>& truth) {
+  if (!truth || *truth == 0.0 || !std::isfinite(value)) return kNaN;
+  return 100.0 * (value - *truth) / *truth;
+}
+
+double drop(double before, double after) { return before > 0.0 ? 1.0 - after / before : 0.0; }
+
+}  // namespace
+
+double ParameterChange::error_before_percent() const { return error_percent(before, truth); }
+double ParameterChange::error_after_percent() const { return error_percent(after, truth); }
+
+double EffectComparison::in_sample_drop() const {
+  return drop(before.weighted_rms_in_sample, after.weighted_rms_in_sample);
+}
+double EffectComparison::held_out_drop() const {
+  return drop(before.weighted_rms_held_out, after.weighted_rms_held_out);
+}
+
+EffectComparison compare_effect(const model::Model& model, const std::vector<std::string>& declared,
+                                const std::string& effect,
+                                const std::vector<ingest::PreprocessedSegment>& run,
+                                double sample_rate_hz, int odmf, const FitOptions& options,
+                                const std::map<std::string, double>& truth) {
+  EffectComparison c;
+  c.effect = effect;
+  c.before = fit_model(model, declared, run, sample_rate_hz, odmf, options);
+  std::vector<std::string> with = declared;
+  with.push_back(effect);
+  FitOptions same_scale = options;  // the declared model's weights: one scale for both fits
+  same_scale.group_weights.clear();
+  for (const GroupFit& g : c.before.groups) same_scale.group_weights.push_back(g.sigma > 0.0 ? 1.0 / g.sigma : 0.0);
+  c.after = fit_model(model, with, run, sample_rate_hz, odmf, same_scale);
+  const ls::Estimate& b = c.before.estimate;
+  const ls::Estimate& a = c.after.estimate;
+  for (std::size_t i = 0; i < c.after.parameters.size(); ++i) {
+    const model::ParameterInfo& p = c.after.parameters[i];
+    ParameterChange change{p.name, p.unit, kNaN, kNaN, a.value(static_cast<Eigen::Index>(i)),
+                           a.standard_deviation(static_cast<Eigen::Index>(i)), std::nullopt};
+    if (i < c.before.parameters.size()) {
+      change.before = b.value(static_cast<Eigen::Index>(i));
+      change.std_before = b.standard_deviation(static_cast<Eigen::Index>(i));
+    }
+    if (const auto t = truth.find(p.name); t != truth.end()) change.truth = t->second;
+    c.parameters.push_back(change);
+  }
+  return c;
+}
+
+}  // namespace dynid::residual

@@ -1,0 +1,194 @@
+#include "dynid/residual/effect_screen.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include "dynid/error.hpp"
+#include "dynid/model/effects.hpp"
+#include "dynid/residual/road_profile.hpp"
+#include "folded_rows.hpp"
+
+namespace dynid::residual {
+namespace {
+
+// Drops closer than this are ties (the same column under two names).
+constexpr double kTie = 1e-9;
+
+struct Candidate {
+  std::string effect;
+  std::string description;
+  CandidateKind kind;
+};
+
+bool contains(const std::vector<std::string>& list, const std::string& name) {
+  return std::find(list.begin(), list.end(), name) != list.end();
+}
+
+// The channels of the model's physics: its own and its candidate effects' (d_<x> read as x:
+// the dictionary's own d/dt covers it).
+std::vector<std::string> physics_channels(const model::Model& m) {
+  std::vector<std::string> out;
+  auto add = [&](std::string name) {
+    if (name.rfind("d_", 0) == 0) name = name.substr(2);
+    if (!contains(out, name)) out.push_back(name);
+  };
+  for (const model::ChannelNeed& c : m.channels()) add(c.name);
+  for (const model::Effect& e : m.candidate_effects())
+    for (const std::string& c : e.channels) add(c);
+  return out;
+}
+
+// Dictionary terms over the run's announced channels (not the derived d_ ones), except over the
+// model's measured side, and, unless all_channels, only over the model's physics channels.
+std::vector<Candidate> dictionary_candidates(const model::Model& m,
+                                             const std::vector<ingest::PreprocessedSegment>& run,
+                                             bool all_channels) {
+  const std::vector<std::string> physics = physics_channels(m);
+  model::ChannelSet announced(run.front().channels.sample_period(), 0);
+  for (const std::string& name : run.front().channels.names())
+    if (name.rfind("d_", 0) != 0 && !contains(m.measured_side(), name) &&
+        (all_channels || contains(physics, name)))
+      announced.add(name, run.front().channels.unit(name), Eigen::VectorXd());
+  std::vector<Candidate> out;
+  for (const model::Effect& e : model::dictionary_effects(announced))
+    out.push_back({e.name, e.description, CandidateKind::kDictionary});
+  return out;
+}
+
+std::vector<Candidate> candidates_of(const model::Model& m, const std::vector<std::string>& declared,
+                                     const std::vector<ingest::PreprocessedSegment>& run,
+                                     const ScreenOptions& options) {
+  std::vector<Candidate> all;
+  for (const model::Effect& e : m.candidate_effects())
+    all.push_back({e.name, e.description, CandidateKind::kPhysics});
+  if (options.road_profile && run.front().channels.has("vx"))
+    all.push_back({road_profile_effect_name(m),
+                   "an unmeasured road property (grade, bank) piecewise linear in the distance "
+                   "travelled, knots every " +
+                       std::to_string(static_cast<int>(options.fit.profile_knot_spacing_m)) + " m",
+                   CandidateKind::kRoadProfile});
+  if (options.dictionary)
+    for (Candidate& c : dictionary_candidates(m, run, options.dictionary_all_channels))
+      all.push_back(std::move(c));
+  std::vector<Candidate> out;
+  for (Candidate& c : all) {
+    if (contains(declared, c.effect)) continue;
+    if (!options.only.empty() && !contains(options.only, c.effect)) continue;
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+// Weighted sums of squares of the model without the candidate (first `base` columns) and with
+// it, on the candidate's rows, under the declared model's fixed group weights.
+CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, Eigen::Index base,
+                     const std::vector<double>& weights, double min_drop) {
+  std::vector<Eigen::Index> base_columns(static_cast<std::size_t>(base));
+  std::iota(base_columns.begin(), base_columns.end(), Eigen::Index{0});
+  const detail::Evaluation before = detail::evaluate(rows, base_columns, weights);
+  const detail::Evaluation after = detail::evaluate(rows, {}, weights);
+  CandidateScore s;
+  s.effect = c.effect;
+  s.description = c.description;
+  s.kind = c.kind;
+  s.columns = rows.parameters.size() - static_cast<std::size_t>(base);
+  s.rows = after.total_rows();
+  s.evaluated = true;
+  const double ss_before = before.weighted_in();
+  const double ss_after = after.weighted_in();
+  s.in_sample_drop = ss_before > 0.0 ? 1.0 - ss_after / ss_before : 0.0;
+  const double dof = static_cast<double>(s.rows) - static_cast<double>(rows.parameters.size());
+  s.f_statistic = ss_after > 0.0 && dof > 0.0
+                      ? ((ss_before - ss_after) / static_cast<double>(s.columns)) / (ss_after / dof)
+                      : 0.0;
+  const auto n = static_cast<double>(s.rows);
+  s.held_out_rms_before = std::sqrt(before.weighted_out() / n);
+  s.held_out_rms_after = std::sqrt(after.weighted_out() / n);
+  s.held_out_drop = s.held_out_rms_before > 0.0 ? 1.0 - s.held_out_rms_after / s.held_out_rms_before : 0.0;
+  for (std::size_t k = 0; k < after.fold_weighted_out.size(); ++k) {
+    const double a = after.fold_weighted_out[k];
+    const double b = before.fold_weighted_out[k];
+    if (std::isnan(a) || std::isnan(b)) continue;
+    ++s.folds;
+    if (a < b) ++s.folds_improved;
+  }
+  s.significant = s.held_out_drop >= min_drop && s.folds > 0 && s.folds_improved == s.folds;
+  return s;
+}
+
+bool ranks_before(const CandidateScore& a, const CandidateScore& b) {
+  if (a.evaluated != b.evaluated) return a.evaluated;
+  if (a.significant != b.significant) return a.significant;
+  if (a.significant && a.kind != b.kind) return static_cast<int>(a.kind) < static_cast<int>(b.kind);
+  if (std::abs(a.held_out_drop - b.held_out_drop) > kTie) return a.held_out_drop > b.held_out_drop;
+  return static_cast<int>(a.kind) < static_cast<int>(b.kind);
+}
+
+std::string percent(double fraction) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f %%", 100.0 * fraction);
+  return buf;
+}
+
+}  // namespace
+
+const char* kind_name(CandidateKind kind) {
+  switch (kind) {
+    case CandidateKind::kPhysics: return "physics";
+    case CandidateKind::kRoadProfile: return "road profile";
+    case CandidateKind::kDictionary: return "dictionary";
+  }
+  return "?";
+}
+
+const CandidateScore* ScreenResult::best() const {
+  return !candidates.empty() && candidates.front().significant ? &candidates.front() : nullptr;
+}
+
+std::string ScreenResult::verdict() const {
+  if (const CandidateScore* b = best())
+    return b->effect + " (" + kind_name(b->kind) + ") explains the residual of " + fit.model +
+           ": held-out RMS " + percent(-b->held_out_drop) + " (in sample " +
+           percent(-b->in_sample_drop) + "), every fold of " + std::to_string(b->folds) + " improves";
+  const auto first = std::find_if(candidates.begin(), candidates.end(),
+                                  [](const CandidateScore& c) { return c.evaluated; });
+  if (first == candidates.end()) return "no candidate effect could be tested on this run";
+  return "nothing significant: no candidate lowers the held-out RMS of " + fit.model +
+         " enough in every fold; the best, " + first->effect + ", " +
+         percent(-first->held_out_drop) + " (" + std::to_string(first->folds_improved) + " of " +
+         std::to_string(first->folds) + " folds improve)";
+}
+
+ScreenResult screen_effects(const model::Model& model, const std::vector<std::string>& declared,
+                            const std::vector<ingest::PreprocessedSegment>& run,
+                            double sample_rate_hz, int odmf, const ScreenOptions& options) {
+  if (run.empty()) throw InputError("residual analysis of " + model.name() + ": the run has no valid segment");
+  ScreenResult result;
+  result.fit = fit_model(model, declared, run, sample_rate_hz, odmf, options.fit);
+  std::vector<double> weights;
+  for (const GroupFit& g : result.fit.groups) weights.push_back(g.sigma > 0.0 ? 1.0 / g.sigma : 0.0);
+  FitOptions fold_options = options.fit;
+  fold_options.series = false;
+  const auto base = static_cast<Eigen::Index>(model.parameters_with(declared).size());
+  for (const Candidate& c : candidates_of(model, declared, run, options)) {
+    std::vector<std::string> with = declared;
+    with.push_back(c.effect);
+    try {
+      const detail::FoldedRows rows = detail::fold_rows(model, with, run, sample_rate_hz, odmf, fold_options, false);
+      result.candidates.push_back(score(c, rows, base, weights, options.min_held_out_drop));
+    } catch (const InputError& e) {
+      CandidateScore s;
+      s.effect = c.effect;
+      s.description = c.description;
+      s.kind = c.kind;
+      s.note = e.what();
+      result.candidates.push_back(std::move(s));
+    }
+  }
+  std::stable_sort(result.candidates.begin(), result.candidates.end(), ranks_before);
+  return result;
+}
+
+}  // namespace dynid::residual

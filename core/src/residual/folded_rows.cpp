@@ -1,0 +1,249 @@
+#include "folded_rows.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "dynid/error.hpp"
+#include "dynid/residual/road_profile.hpp"
+
+namespace dynid::residual::detail {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string format_metres(double m) {
+  return std::to_string(static_cast<long long>(std::llround(m))) + "m";
+}
+
+// The parameters a road profile adds: one per knot and group.
+void add_profile_parameters(const std::string& effect, const std::vector<std::string>& groups,
+                            const RoadProfile& profile, FoldedRows& out) {
+  for (const std::string& g : groups)
+    for (Eigen::Index k = 0; k < profile.knots(); ++k) {
+      const std::string suffix = groups.size() > 1 ? "@" + g : "";
+      out.parameters.push_back({effect + suffix + "@" + format_metres(profile.knot_distance(k)), "",
+                                "the road profile's contribution at this knot (y units)",
+                                std::nullopt});
+    }
+  for (Eigen::Index k = 0; k < profile.knots(); ++k) out.profile_knots_m.push_back(profile.knot_distance(k));
+}
+
+// Row buffers of one segment, per fold and group, folded in one batch each.
+struct SegmentBuffers {
+  std::vector<std::vector<std::vector<double>>> values;  // [fold][group] rows of [w y]
+  SegmentBuffers(int folds, std::size_t groups)
+      : values(static_cast<std::size_t>(folds), std::vector<std::vector<double>>(groups)) {}
+  void fold_into(std::vector<ls::EquationGroups>& folds, Eigen::Index width) {
+    for (std::size_t f = 0; f < values.size(); ++f)
+      for (std::size_t g = 0; g < values[f].size(); ++g) {
+        std::vector<double>& v = values[f][g];
+        if (v.empty()) continue;
+        const Eigen::Index m = static_cast<Eigen::Index>(v.size()) / (width + 1);
+        const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> rows(
+            v.data(), m, width + 1);
+        folds[f].group(g).fold_augmented(rows);
+        v.clear();
+      }
+  }
+};
+
+}  // namespace
+
+std::uint64_t FoldedRows::rows() const {
+  std::uint64_t n = 0;
+  for (const ls::EquationGroups& f : folds)
+    for (std::size_t g = 0; g < f.size(); ++g) n += f.group(g).row_count();
+  return n;
+}
+
+FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& effects,
+                     const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
+                     int odmf, const FitOptions& options, bool collect) {
+  options.cross_validation.validate();
+  if (odmf < 1) throw InputError("residual analysis: odmf " + std::to_string(odmf) + " < 1");
+  std::vector<std::string> model_effects;
+  std::string profile_effect;
+  for (const std::string& e : effects) {
+    if (!is_road_profile_effect(e)) {
+      model_effects.push_back(e);
+    } else if (profile_effect.empty()) {
+      profile_effect = e;
+    } else {
+      throw InputError("residual analysis: at most one road profile effect (" + profile_effect +
+                       ", " + e + ")");
+    }
+  }
+  FoldedRows out;
+  out.parameters = model.parameters_with(model_effects);
+  out.groups = model.groups();
+  const auto model_width = static_cast<Eigen::Index>(out.parameters.size());
+  std::unique_ptr<RoadProfile> profile;
+  if (!profile_effect.empty()) {
+    profile = std::make_unique<RoadProfile>(run, 1.0 / sample_rate_hz, options.profile_knot_spacing_m);
+    add_profile_parameters(profile_effect, out.groups, *profile, out);
+  }
+  const auto width = static_cast<Eigen::Index>(out.parameters.size());
+  if (effects.empty()) {
+    out.last_effect_first = out.last_effect_end = width;
+  } else if (is_road_profile_effect(effects.back())) {
+    out.last_effect_first = model_width;
+    out.last_effect_end = width;
+  } else {
+    const std::vector<std::string> before(model_effects.begin(), model_effects.end() - 1);
+    out.last_effect_first = static_cast<Eigen::Index>(model.parameters_with(before).size());
+    out.last_effect_end = model_width;
+  }
+  const std::size_t group_count = out.groups.size();
+  out.folds.assign(static_cast<std::size_t>(options.cross_validation.folds),
+                   ls::EquationGroups(width, out.groups));
+  if (collect) {
+    out.collected.time_s.resize(group_count);
+    out.collected.grid_index.resize(group_count);
+    out.collected.values.resize(group_count);
+  }
+  SegmentBuffers buffers(options.cross_validation.folds, group_count);
+  std::vector<double> row(static_cast<std::size_t>(width + 1));
+  for (std::size_t s = 0; s < run.size(); ++s) {
+    const ingest::PreprocessedSegment& seg = run[s];
+    const std::vector<model::GroupRows> built = model.rows(seg.channels, model_effects);
+    for (std::size_t g = 0; g < built.size(); ++g) {
+      const model::GroupRows& gr = built[g];
+      for (std::size_t i = 0; i < gr.samples.size(); ++i) {
+        const Eigen::Index sample = gr.samples[i];
+        if (!ingest::on_decimation_grid(seg, sample, odmf)) continue;
+        std::fill(row.begin(), row.end(), 0.0);
+        for (Eigen::Index j = 0; j < model_width; ++j)
+          row[static_cast<std::size_t>(j)] = gr.W(static_cast<Eigen::Index>(i), j);
+        if (profile)
+          profile->hats(profile->distance(s, sample),
+                        row.data() + model_width + static_cast<Eigen::Index>(g) * profile->knots());
+        row.back() = gr.y(static_cast<Eigen::Index>(i));
+        const Eigen::Index grid = seg.first + sample;
+        const double t = static_cast<double>(grid) / sample_rate_hz;
+        auto& dest = buffers.values[static_cast<std::size_t>(options.cross_validation.fold_of(t))][g];
+        dest.insert(dest.end(), row.begin(), row.end());
+        if (collect) {
+          out.collected.time_s[g].push_back(t);
+          out.collected.grid_index[g].push_back(grid);
+          out.collected.values[g].insert(out.collected.values[g].end(), row.begin(), row.end());
+        }
+      }
+    }
+    buffers.fold_into(out.folds, width);
+  }
+  if (out.rows() == 0)
+    throw InputError("model " + model.name() + ": no row on the run (masking, or no valid segment)");
+  return out;
+}
+
+Eigen::VectorXd base_solution(const ls::Estimate& estimate) {
+  Eigen::VectorXd x = estimate.value;
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    if (!std::isfinite(x(i))) x(i) = 0.0;
+  return x;
+}
+
+namespace {
+
+ls::EquationGroups selected(const ls::EquationGroups& groups, const std::vector<Eigen::Index>& columns,
+                            const std::vector<std::string>& names) {
+  if (columns.empty()) return groups;
+  ls::EquationGroups out(static_cast<Eigen::Index>(columns.size()), names);
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    if (groups.group(g).row_count() > 0) out.group(g) = groups.group(g).select_columns(columns);
+  return out;
+}
+
+ls::EquationGroups merged(const std::vector<ls::EquationGroups>& folds, int except,
+                          const std::vector<std::string>& names) {
+  ls::EquationGroups out(folds.front().group(0).parameter_count(), names);
+  for (std::size_t f = 0; f < folds.size(); ++f) {
+    if (static_cast<int>(f) == except) continue;
+    for (std::size_t g = 0; g < names.size(); ++g) out.group(g).merge(folds[f].group(g));
+  }
+  return out;
+}
+
+std::uint64_t rows_of(const ls::EquationGroups& groups) {
+  std::uint64_t n = 0;
+  for (std::size_t g = 0; g < groups.size(); ++g) n += groups.group(g).row_count();
+  return n;
+}
+
+std::vector<double> own_weights(const std::vector<ls::GroupStatistics>& groups,
+                                const std::vector<std::string>& names) {
+  std::vector<double> w(names.size(), 0.0);
+  for (const ls::GroupStatistics& s : groups)
+    for (std::size_t g = 0; g < names.size(); ++g)
+      if (names[g] == s.name) w[g] = s.weight;
+  return w;
+}
+
+}  // namespace
+
+double Evaluation::weighted_in() const {
+  double s = 0.0;
+  for (std::size_t g = 0; g < rss_in.size(); ++g) s += weights[g] * weights[g] * rss_in[g];
+  return s;
+}
+
+double Evaluation::weighted_out() const {
+  double s = 0.0;
+  for (std::size_t g = 0; g < rss_out.size(); ++g) s += weights[g] * weights[g] * rss_out[g];
+  return s;
+}
+
+std::uint64_t Evaluation::total_rows() const {
+  std::uint64_t n = 0;
+  for (std::uint64_t r : rows) n += r;
+  return n;
+}
+
+Evaluation evaluate(const FoldedRows& rows, const std::vector<Eigen::Index>& columns,
+                    const std::vector<double>& weights) {
+  const std::vector<std::string>& names = rows.groups;
+  std::vector<ls::EquationGroups> folds;
+  for (const ls::EquationGroups& f : rows.folds) folds.push_back(selected(f, columns, names));
+  Evaluation e;
+  const ls::EquationGroups all = merged(folds, -1, names);
+  ls::WeightedEstimate fit = all.estimate();
+  e.all = std::move(fit.estimate);
+  e.group_statistics = std::move(fit.groups);
+  e.x = base_solution(e.all);
+  e.weights = weights.empty() ? own_weights(e.group_statistics, names) : weights;
+  const std::size_t group_count = names.size();
+  e.rows.assign(group_count, 0);
+  e.ss_measured.assign(group_count, 0.0);
+  e.rss_in.assign(group_count, 0.0);
+  e.rss_out.assign(group_count, 0.0);
+  for (std::size_t g = 0; g < group_count; ++g) {
+    const ls::Accumulator& a = all.group(g);
+    e.rows[g] = a.row_count();
+    if (a.row_count() == 0) continue;
+    e.ss_measured[g] = a.measured_norm() * a.measured_norm();
+    const double r = a.residual_norm_at(e.x);
+    e.rss_in[g] = r * r;
+  }
+  for (std::size_t k = 0; k < folds.size(); ++k) {
+    const ls::EquationGroups train = merged(folds, static_cast<int>(k), names);
+    if (rows_of(train) == 0 || rows_of(folds[k]) == 0) {
+      e.fold_weighted_out.push_back(kNaN);
+      continue;
+    }
+    const Eigen::VectorXd xk = base_solution(train.estimate().estimate);
+    double weighted = 0.0;
+    for (std::size_t g = 0; g < group_count; ++g) {
+      const ls::Accumulator& test = folds[k].group(g);
+      if (test.row_count() == 0) continue;
+      const double r = test.residual_norm_at(xk);
+      e.rss_out[g] += r * r;
+      weighted += e.weights[g] * e.weights[g] * r * r;
+    }
+    e.fold_weighted_out.push_back(weighted);
+  }
+  return e;
+}
+
+}  // namespace dynid::residual::detail

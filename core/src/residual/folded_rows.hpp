@@ -1,0 +1,67 @@
+#pragma once
+// Internal: the rows of one model configuration over a recorded run, folded into one set of
+// equation-group accumulators per cross-validation fold, and their evaluation (in sample and
+// held out) on any prefix-free column selection. Contracts of the public headers apply.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "dynid/ingest/recorded_run.hpp"
+#include "dynid/ls/equation_groups.hpp"
+#include "dynid/model/model.hpp"
+#include "dynid/residual/model_fit.hpp"
+
+namespace dynid::residual::detail {
+
+/// Every kept row, per group, for the time series (W and y as folded).
+struct CollectedRows {
+  std::vector<std::vector<double>> time_s;          // per group
+  std::vector<std::vector<Eigen::Index>> grid_index;  // per group, run grid index
+  std::vector<std::vector<double>> values;          // per group, rows of [w y] back to back
+};
+
+struct FoldedRows {
+  std::vector<model::ParameterInfo> parameters;
+  std::vector<std::string> groups;
+  std::vector<ls::EquationGroups> folds;
+  std::vector<double> profile_knots_m;  // empty without a road profile
+  // Columns [last_effect_first, last_effect_end) are the last effect given (empty range
+  // without effects).
+  Eigen::Index last_effect_first = 0;
+  Eigen::Index last_effect_end = 0;
+  CollectedRows collected;
+  std::uint64_t rows() const;
+};
+
+/// `effects`: model and dictionary effects, and at most one road-profile effect (its columns
+/// come last). Throws InputError (missing channel, unknown effect, no row on the grid).
+FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& effects,
+                     const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
+                     int odmf, const FitOptions& options, bool collect);
+
+struct Evaluation {
+  ls::Estimate all;
+  std::vector<ls::GroupStatistics> group_statistics;
+  Eigen::VectorXd x;                   // the in-sample solution, 0 where not identifiable
+  std::vector<double> weights;         // per group (fixed or the fit's own 1/sigma_j)
+  std::vector<std::uint64_t> rows;     // per group
+  std::vector<double> ss_measured;     // per group ||y||^2
+  std::vector<double> rss_in;          // per group
+  std::vector<double> rss_out;         // per group, summed over folds
+  std::vector<double> fold_weighted_out;  // per fold sum_g w_g^2 rss_out; NaN: fold not predicted
+  double weighted_in() const;          // sum_g w_g^2 rss_in
+  double weighted_out() const;
+  std::uint64_t total_rows() const;
+};
+
+/// Evaluates the columns `columns` (increasing; empty = all) of `rows`. `weights` per group of
+/// rows.groups (empty: the in-sample fit's own DYCARO weights).
+Evaluation evaluate(const FoldedRows& rows, const std::vector<Eigen::Index>& columns,
+                    const std::vector<double>& weights);
+
+/// The solution with NaN (not identifiable) entries set to 0: the base-parameter solution.
+Eigen::VectorXd base_solution(const ls::Estimate& estimate);
+
+}  // namespace dynid::residual::detail
