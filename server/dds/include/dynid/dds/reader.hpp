@@ -10,11 +10,16 @@
 //   an empty result means the timeout passed. Never blocks longer than `timeout`.
 // - Samples are returned as received: validate them with from_wire() (conversions.hpp)
 //   before use; a malformed one is an InputError there, not a crash.
+// - On a wildcard partition (e.g. kAllVehiclesPartition), a sample with a vehicle key is
+//   returned only if its writer wrote in that vehicle's own partition; the others are dropped,
+//   counted (refused_by_partition()) and logged (sender_partition.hpp: what DDS Security's
+//   per-partition grants need to confine a car to its own vehicle's data).
 // - The Participant must outlive the Reader.
 #include <dds/dds.h>
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,6 +27,7 @@
 #include "dynid/dds/error.hpp"
 #include "dynid/dds/participant.hpp"
 #include "dynid/dds/sample.hpp"
+#include "dynid/dds/sender_partition.hpp"
 #include "dynid/dds/topics.hpp"
 #include "dynid/dds/writer.hpp"
 
@@ -46,6 +52,7 @@ class Reader {
                                     Topic<T>::qos())),
         reader_(detail::create_reader(participant, topic_,
                                       Topic<T>::qos().partitions(partitions))),
+        guard_(reader_.get(), partitions),
         waitset_(participant, reader_.get()) {}
 
   std::vector<Sample<T>> take(std::size_t max = 64) {
@@ -60,7 +67,8 @@ class Reader {
     std::vector<Sample<T>> taken;
     for (dds_return_t k = 0; k < n; ++k) {
       const auto index = static_cast<std::size_t>(k);
-      if (infos[index].valid_data) taken.push_back(std::move(samples[index]));
+      if (infos[index].valid_data && from_own_partition(samples[index].data, infos[index]))
+        taken.push_back(std::move(samples[index]));
     }
     return taken;
   }
@@ -81,10 +89,19 @@ class Reader {
   }
 
   dds_entity_t handle() const { return reader_.get(); }
+  std::uint64_t refused_by_partition() const { return guard_.refused(); }
 
  private:
+  bool from_own_partition(const T& data, const dds_sample_info_t& info) {
+    if constexpr (requires { data.vehicle; })
+      return guard_.admits(info.publication_handle, data.vehicle, sizeof data.vehicle);
+    else
+      return true;  // requests and replies: not per vehicle
+  }
+
   Entity topic_;
   Entity reader_;
+  SenderPartitionGuard guard_;
   detail::DataWaitset waitset_;  // last: deleted first
 };
 
