@@ -45,7 +45,10 @@ void print_ranking(const ScreenResult& screen, std::size_t top) {
               "significant");
   for (std::size_t i = 0; i < screen.candidates.size() && i < top; ++i) {
     const CandidateScore& c = screen.candidates[i];
-    if (!c.evaluated) break;
+    if (!c.evaluated) {
+      std::printf("%-34s %-12s not tested: %s\n", c.effect.c_str(), kind_name(c.kind), c.note.c_str());
+      continue;
+    }
     std::printf("%-34s %-12s %9.2f %9.2f %10.3g %3d/%-2d %s\n", c.effect.c_str(), kind_name(c.kind),
                 100.0 * c.in_sample_drop, 100.0 * c.held_out_drop, c.f_statistic, c.folds_improved, c.folds,
                 c.significant ? "yes" : "no");

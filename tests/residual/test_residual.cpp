@@ -119,9 +119,11 @@ TEST(EffectScreen, SaysSoWhenNothingIsSignificant) {
   const auto model = model::make_model("kinematic_longitudinal", {});
   auto run = hilly_run(0.05);
   ScreenOptions options;
-  options.only = {"dict:x:steer", "dict:sq:steer", "dict:sgn:steer"};
+  options.dictionary_all_channels = true;  // steer is no channel of this model's physics
+  options.only = {"dict:x:steer", "dict:sq:steer", "dict:sgn:steer", "dict:x:vx", "dict:sq:vx"};
   const ScreenResult screen = screen_effects(*model, {"road_grade"}, run, kRate, 5, options);
   EXPECT_EQ(screen.best(), nullptr);
+  EXPECT_EQ(screen.candidates.size(), 5U);
   EXPECT_NE(screen.verdict().find("nothing significant"), std::string::npos) << screen.verdict();
 }
 

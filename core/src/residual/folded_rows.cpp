@@ -81,7 +81,8 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   const auto model_width = static_cast<Eigen::Index>(out.parameters.size());
   std::unique_ptr<RoadProfile> profile;
   if (!profile_effect.empty()) {
-    profile = std::make_unique<RoadProfile>(run, 1.0 / sample_rate_hz, options.profile_knot_spacing_m);
+    profile = std::make_unique<RoadProfile>(run, 1.0 / sample_rate_hz, options.profile_knot_spacing_m,
+                                            options.cross_validation.block_seconds);
     add_profile_parameters(profile_effect, out.groups, *profile, out);
   }
   const auto width = static_cast<Eigen::Index>(out.parameters.size());
@@ -90,6 +91,7 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   } else if (is_road_profile_effect(effects.back())) {
     out.last_effect_first = model_width;
     out.last_effect_end = width;
+    out.last_effect_is_profile = true;
   } else {
     const std::vector<std::string> before(model_effects.begin(), model_effects.end() - 1);
     out.last_effect_first = static_cast<Eigen::Index>(model.parameters_with(before).size());

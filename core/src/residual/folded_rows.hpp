@@ -31,6 +31,7 @@ struct FoldedRows {
   // without effects).
   Eigen::Index last_effect_first = 0;
   Eigen::Index last_effect_end = 0;
+  bool last_effect_is_profile = false;
   CollectedRows collected;
   std::uint64_t rows() const;
 };

@@ -34,9 +34,13 @@ ResidualSeries series_of(const detail::FoldedRows& rows, const detail::Evaluatio
   s.measured = all.col(width);
   s.residual = s.measured - all.leftCols(width) * e.x;
   const Eigen::Index effect_columns = rows.last_effect_end - rows.last_effect_first;
-  if (effect_columns > 0)
+  if (effect_columns > 0) {
     s.effect_contribution = all.middleCols(rows.last_effect_first, effect_columns) *
                             e.x.segment(rows.last_effect_first, effect_columns);
+    // A road profile's level is not separable from an offset column (its hats sum to 1).
+    if (rows.last_effect_is_profile && s.effect_contribution.size() > 0)
+      s.effect_contribution.array() -= s.effect_contribution.mean();
+  }
   s.spectrum = residual_spectrum(rows.collected.grid_index[g], s.residual, odmf, sample_rate_hz);
   return s;
 }

@@ -9,12 +9,13 @@
 namespace dynid::residual {
 
 RoadProfile::RoadProfile(const std::vector<ingest::PreprocessedSegment>& segments,
-                         double sample_period, double knot_spacing_m)
+                         double sample_period, double knot_spacing_m, double held_out_block_s)
     : spacing_(knot_spacing_m) {
   if (!(knot_spacing_m > 0.0) || !std::isfinite(knot_spacing_m))
     throw InputError("road profile: knot spacing " + std::to_string(knot_spacing_m) +
                      " m is not positive");
   double travelled = 0.0;
+  double duration = 0.0;
   for (std::size_t s = 0; s < segments.size(); ++s) {
     const ingest::PreprocessedSegment& seg = segments[s];
     if (!seg.channels.has("vx")) throw InputError("road profile: the run has no channel 'vx'");
@@ -32,7 +33,9 @@ RoadProfile::RoadProfile(const std::vector<ingest::PreprocessedSegment>& segment
       d(k) = travelled;
     }
     distance_.push_back(std::move(d));
+    duration += sample_period * static_cast<double>(vx.size());
   }
+  if (duration > 0.0) spacing_ = std::max(spacing_, 2.0 * held_out_block_s * travelled / duration);
   knots_ = static_cast<Eigen::Index>(std::floor(travelled / spacing_)) + 2;
 }
 

@@ -42,7 +42,8 @@ struct ResidualSeries {
   std::vector<double> time_s;   ///< run time of each row (run grid index / sample rate)
   Eigen::VectorXd measured;     ///< y
   Eigen::VectorXd residual;     ///< y - W x
-  /// The fitted contribution of the effect's columns (W_effect x_effect); empty without one.
+  /// The fitted contribution of the last effect's columns (W_effect x_effect); empty without
+  /// one. A road profile's is centred on its mean (its level is the offset's: road_profile.hpp).
   Eigen::VectorXd effect_contribution;
   Spectrum spectrum;  ///< of the residual on the decimated grid (gaps between rows read 0)
 };

@@ -12,6 +12,8 @@
 // (a constant grade and an accelerometer offset are the same column); its shape is what an
 // independent grade (GNSS pose) can confirm.
 //
+// Fits report the profile's contribution centred on its mean over the rows (model_fit.hpp).
+//
 // Distance: the trapezoidal integral of the preprocessed vx over the valid segments; across a
 // gap the speed is taken linear between the segments' end and start (the car did not stop
 // reading). Contract: InputError when the segments lack vx or are not in increasing order.
@@ -27,8 +29,12 @@ namespace dynid::residual {
 
 class RoadProfile {
  public:
+  /// Knots every max(knot_spacing_m, 2 x the distance travelled in `held_out_block_s` at the
+  /// run's mean speed): a knot interval longer than two held-out blocks keeps training rows on
+  /// both sides of every knot, so a held-out block is predicted by interpolation, not by
+  /// extrapolating one knot from the edges of its support.
   RoadProfile(const std::vector<ingest::PreprocessedSegment>& segments, double sample_period,
-              double knot_spacing_m);
+              double knot_spacing_m, double held_out_block_s = 0.0);
 
   double knot_spacing() const { return spacing_; }
   Eigen::Index knots() const { return knots_; }
