@@ -101,7 +101,8 @@ Case road_grade() {
   return {"road grade, longitudinal model", "acceleration.toml", kGradeProfile, "longitudinal_wheel", {}, {},
           true,
           {"road_grade", "road_grade_accelerometer", "road_grade_profile"},
-          {{"mass", "vehicle.longitudinal_equivalent_mass"}, {"rolling_resistance", "vehicle.road_load_constant_force"}}};
+          {{"mass", "vehicle.longitudinal_equivalent_mass"}, {"SCx", "vehicle.scx"},
+           {"rolling_resistance", "vehicle.road_load_constant_force"}}};
 }
 
 Case anti_roll_bar() {
@@ -131,7 +132,8 @@ Case road_bank() {
 Case brake_drag() {
   return {"brake drag, longitudinal model", "acceleration.toml", "", "longitudinal_wheel", {},
           {{"brake_pressure_threshold", 1.0e6}}, true, {"brake_drag"},
-          {{"mass", "vehicle.longitudinal_equivalent_mass"}, {"rolling_resistance", "vehicle.road_load_constant_force"}},
+          {{"mass", "vehicle.longitudinal_equivalent_mass"}, {"SCx", "vehicle.scx"},
+           {"rolling_resistance", "vehicle.road_load_constant_force"}},
           {}, "drag_pressure = 3.0e5\n"};
 }
 

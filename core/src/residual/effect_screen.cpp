@@ -98,7 +98,7 @@ CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, Eigen::
   s.evaluated = true;
   const double ss_before = before.weighted_in();
   const double ss_after = after.weighted_in();
-  s.in_sample_drop = ss_before > 0.0 ? 1.0 - ss_after / ss_before : 0.0;
+  s.in_sample_drop = ss_before > 0.0 ? 1.0 - std::sqrt(ss_after / ss_before) : 0.0;
   const double dof = static_cast<double>(s.rows) - static_cast<double>(rows.parameters.size());
   s.f_statistic = ss_after > 0.0 && dof > 0.0
                       ? ((ss_before - ss_after) / static_cast<double>(s.columns)) / (ss_after / dof)

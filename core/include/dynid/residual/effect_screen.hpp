@@ -18,8 +18,8 @@
 // [W | C | y] are folded into one accumulator set per cross-validation fold; the model without
 // C on the same rows comes from the same accumulators (Accumulator::select_columns), so the
 // screen needs accumulators only and could run live on the server. Reported: the in-sample drop
-// of the weighted residual sum of squares and its F statistic, and the held-out weighted RMS
-// before and after with the number of folds it improves.
+// of the weighted residual RMS and the F statistic of the added columns, and the held-out
+// weighted RMS before and after with the number of folds it improves.
 //
 // Significant: the held-out weighted RMS drops by at least min_held_out_drop AND every fold
 // improves. The in-sample F is reported, not used: with autocorrelated rows it is large for
@@ -53,7 +53,7 @@ struct CandidateScore {
   std::uint64_t rows = 0;         ///< rows of the model with the effect
   bool evaluated = false;
   std::string note;               ///< why not evaluated (missing channel, no row...)
-  double in_sample_drop = 0.0;    ///< 1 - SS_after / SS_before (weighted, same rows)
+  double in_sample_drop = 0.0;    ///< 1 - RMS_after / RMS_before (weighted, same rows)
   double f_statistic = 0.0;
   double held_out_rms_before = 0.0;  ///< weighted
   double held_out_rms_after = 0.0;
