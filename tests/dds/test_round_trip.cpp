@@ -87,7 +87,7 @@ TEST(DdsRoundTrip, RequestAndReplyKeepTheirCorrelation) {
 
   const std::string binary("a\0b\xff", 4);
   const Reply reply{seen.client, seen.correlation_id, ReplyStatus::kNotFound, "no estimate yet",
-                    "application/octet-stream", binary};
+                    "application/octet-stream", binary, 2, 3};
   ASSERT_TRUE(replies.write(to_wire(reply).data));
   auto back = take_count(answers, 1);
   ASSERT_EQ(back.size(), 1u);
@@ -96,6 +96,8 @@ TEST(DdsRoundTrip, RequestAndReplyKeepTheirCorrelation) {
   EXPECT_EQ(answer.status, ReplyStatus::kNotFound);
   EXPECT_EQ(answer.error, "no estimate yet");
   EXPECT_EQ(answer.payload, binary);
+  EXPECT_EQ(answer.shard, 2u);
+  EXPECT_EQ(answer.shard_count, 3u);
 }
 
 }  // namespace

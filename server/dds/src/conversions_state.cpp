@@ -64,6 +64,12 @@ ReplyStatus reply_status_from_wire(long long raw, const std::string& where) {
   throw InputError(where + ": unknown status " + std::to_string(raw));
 }
 
+void check_reply_shard(std::uint32_t shard, std::uint32_t count, const std::string& where) {
+  if (count != 0 && shard >= count)
+    throw InputError(where + ": shard " + std::to_string(shard) + " of " + std::to_string(count) +
+                     " (expected K < N)");
+}
+
 void put_parameter(dynid_wire_ParameterRow& out, const ParameterEntry& entry,
                    const std::string& where) {
   put_id(out.name, entry.name, where + " parameter name");
@@ -208,6 +214,9 @@ Sample<dynid_wire_Reply> to_wire(const Reply& reply) {
   auto* payload = allocate(sample.data.payload, reply.payload.size(), dynid_wire_kMaxPayload,
                            where + " payload bytes");
   if (payload != nullptr) std::copy(reply.payload.begin(), reply.payload.end(), payload);
+  check_reply_shard(reply.shard, reply.shard_count, where);
+  sample.data.shard = reply.shard;
+  sample.data.shard_count = reply.shard_count;
   return sample;
 }
 
@@ -221,6 +230,9 @@ Reply from_wire(const dynid_wire_Reply& sample) {
   reply.payload_format = get(sample.payload_format, where + " payload format");
   const auto payload = elements(sample.payload, dynid_wire_kMaxPayload, where + " payload");
   reply.payload.assign(payload.begin(), payload.end());
+  check_reply_shard(sample.shard, sample.shard_count, where);
+  reply.shard = sample.shard;
+  reply.shard_count = sample.shard_count;
   return reply;
 }
 

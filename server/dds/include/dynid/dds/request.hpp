@@ -32,6 +32,10 @@ struct Reply {
   std::string error;           ///< readable reason when status != kOk
   std::string payload_format;  ///< e.g. "text/plain", "application/json"
   std::string payload;         ///< bytes
+  /// The answering server's shard K of N; shard_count 0 when the server does not say (one
+  /// server, or one older than the field). to_wire/from_wire refuse shard >= shard_count > 0.
+  std::uint32_t shard = 0;
+  std::uint32_t shard_count = 0;
 };
 
 }  // namespace dynid::dds
