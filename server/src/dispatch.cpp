@@ -1,6 +1,7 @@
 // Server::Impl: the dispatcher's steps, from DDS samples to worker tasks (server.hpp).
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstring>
 
 #include "dynid/dds/conversions.hpp"
@@ -99,6 +100,17 @@ void Server::Impl::dispatch_requests() {
   }
 }
 
+// Every server sees every request (docs/DESIGN.md, Scale-out). One naming a vehicle is its
+// owner's; a fleet is answered by the owners of its vehicles (one computes it, or each refuses
+// a fleet that spans shards); the others (vehicles, status) by every shard, the client merges.
+bool Server::Impl::concerns_this_shard(const ParsedRequest& parsed) const {
+  if (const auto vehicle = parsed.optional("vehicle")) return options.shard.owns(*vehicle);
+  if (parsed.kind != "fleet") return true;
+  const auto vehicles = split_list(parsed.required("vehicles"));
+  return vehicles.empty() ||
+         std::any_of(vehicles.begin(), vehicles.end(), [&](const auto& v) { return options.shard.owns(v); });
+}
+
 // Parses, routes to a shard and a worker, executes there and replies.
 void Server::Impl::accept_request(const dds::Request& request) {
   ParsedRequest parsed;
@@ -109,9 +121,8 @@ void Server::Impl::accept_request(const dds::Request& request) {
     spdlog::warn("{}", e.what());
     return send(reply_to(request, dds::ReplyStatus::kBadRequest, e.what()));
   }
+  if (!concerns_this_shard(parsed)) return;  // another shard's to answer
   const auto vehicle = parsed.optional("vehicle");
-  if (vehicle ? !options.shard.owns(*vehicle) : !options.shard.answers_fleet_requests())
-    return;  // another shard's to answer
   const ReplyCache::Key key{request.client, request.correlation_id};
   std::optional<dds::Reply> cached;
   if (!reply_cache.begin(key, cached)) {

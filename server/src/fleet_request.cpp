@@ -3,6 +3,7 @@
 // tasks meet in a FleetGather and the last one to finish solves and replies. No worker waits
 // for another (a worker blocking on a future could wait on itself or on a full queue).
 #include <exception>
+#include <map>
 #include <mutex>
 #include <set>
 
@@ -24,15 +25,29 @@ struct FleetGather {
   std::exception_ptr error;  // the first vehicle that failed
 };
 
+// The refusal of a fleet whose vehicles have different owners. Every owner involved sends the
+// same text, so the engineer reads the same answer whichever arrives first.
+std::string spanning_shards(const std::vector<std::string>& vehicles, std::uint32_t count) {
+  std::map<std::uint32_t, std::string> by_shard;
+  for (const auto& v : vehicles) {
+    auto& list = by_shard[Shard::owner_of(v, count)];
+    list += (list.empty() ? "" : ",") + v;
+  }
+  std::string where;
+  for (const auto& [index, list] : by_shard)
+    where += (where.empty() ? "" : "; ") + list + " on shard " + std::to_string(index) + "/" + std::to_string(count);
+  return "fleet: the vehicles are served by different servers (" + where +
+         "): a fleet estimate solves the shared parameters of all its vehicles in one "
+         "factorization on one server, so it spans one shard's vehicles; ask per shard "
+         "(docs/DESIGN.md, Scale-out)";
+}
+
 std::vector<std::string> fleet_vehicles(const ParsedRequest& request, const Shard& shard) {
   const auto vehicles = split_list(request.required("vehicles"));
   if (vehicles.empty()) throw InputError("fleet: name at least one vehicle (--vehicles V1,V2,...)");
   if (std::set<std::string>(vehicles.begin(), vehicles.end()).size() != vehicles.size())
     throw InputError("fleet: a vehicle is named twice (" + request.required("vehicles") + ")");
-  for (const auto& v : vehicles)
-    if (!shard.owns(v))
-      throw InputError("fleet: vehicle " + v + " is served by another shard (this server is shard " +
-                       shard.to_string() + "); a fleet spans one shard's vehicles");
+  if (!shard.foreign_vehicles(vehicles).empty()) throw InputError(spanning_shards(vehicles, shard.count));
   return vehicles;
 }
 

@@ -6,6 +6,7 @@
 
 #include "dynid/dds/conversions.hpp"
 #include "dynid/dds/topics.hpp"
+#include "dynid/error.hpp"
 #include "dynid/report/json.hpp"
 #include "server_impl.hpp"
 
@@ -43,6 +44,7 @@ Server::Impl::Impl(ServerOptions opts)
       waitset(dds::check(dds_create_waitset(participant.handle()), "dds_create_waitset")),
       stop_guard(dds::check(dds_create_guardcondition(participant.handle()),
                             "dds_create_guardcondition")) {
+  refuse_foreign_vehicles();
   for (const dds_entity_t reader : {announcements.handle(), chunks.handle(), requests.handle()}) {
     conditions.emplace_back(dds::check(dds_create_readcondition(reader, DDS_ANY_STATE),
                                        "dds_create_readcondition"));
@@ -58,6 +60,22 @@ Server::Impl::Impl(ServerOptions opts)
 Server::Impl::~Impl() {
   pool.stop();  // finish what is queued while the services and writers still exist
   spdlog::info("dynid-server stopped; counters {}", counters.snapshot().to_json());
+}
+
+// A store holding vehicles of another shard was written by a server started with another
+// --shard (or N changed): serving from it would split those vehicles' runs over two stores.
+void Server::Impl::refuse_foreign_vehicles() {
+  const auto foreign = options.shard.foreign_vehicles(store.with([](store::Store& s) { return s.list_vehicles(); }));
+  if (foreign.empty()) return;
+  std::string list;
+  for (std::size_t k = 0; k < foreign.size() && k < 5; ++k)
+    list += (k ? ", " : "") + foreign[k] + " (shard " +
+            std::to_string(Shard::owner_of(foreign[k], options.shard.count)) + ")";
+  if (foreign.size() > 5) list += ", ...";
+  throw InputError("--shard " + options.shard.to_string() + ": store " + options.store_path + " holds " +
+                   std::to_string(foreign.size()) + " vehicle(s) of other shards: " + list +
+                   "; was it written with another --shard? Vehicles do not move between shards "
+                   "(docs/DESIGN.md, Scale-out)");
 }
 
 void Server::Impl::resume_open_runs() {
@@ -104,7 +122,6 @@ CounterSnapshot Server::counters() const { return impl_->counters.snapshot(); }
 std::string Server::Impl::fleet_reply(const ParsedRequest& request) {
   if (request.kind == "status") return counters.snapshot().to_json();
   auto vehicles = store.with([](store::Store& s) { return s.list_vehicles(); });
-  std::erase_if(vehicles, [&](const std::string& v) { return !options.shard.owns(v); });
   std::string out;
   for (const auto& v : vehicles)
     out += request.json() ? (out.empty() ? "" : ",") + report::json_string(v) : v + "\n";
@@ -136,7 +153,9 @@ dds::Reply Server::Impl::execute(const ParsedRequest& r, RunService& service) {
   return {{}, 0, dds::ReplyStatus::kOk, {}, format, payload};
 }
 
-void Server::Impl::send(const dds::Reply& reply) {
+void Server::Impl::send(dds::Reply reply) {
+  reply.shard = options.shard.index;  // the client counts the shards that answered
+  reply.shard_count = options.shard.count;
   std::lock_guard lock(reply_mutex);
   try {
     replies.write(to_wire(reply).data);

@@ -36,12 +36,16 @@ struct Server::Impl {
   explicit Impl(ServerOptions options);
   ~Impl();
 
+  /// InputError when the store holds vehicles this shard does not own.
+  void refuse_foreign_vehicles();
   void resume_open_runs();
   void dispatch_round();
   void dispatch_announcements();
   void dispatch_chunks();
   void dispatch_requests();
   void dispatch_chunk(const dynid_wire_Chunk& sample);
+  /// Whether this server answers `parsed` (the routing of requests between shards).
+  bool concerns_this_shard(const ParsedRequest& parsed) const;
   void accept_request(const dds::Request& request);
   dds::Reply execute(const ParsedRequest& request, RunService& service);
   /// Runs `work` and replies with its result, or with the status its exception maps to
@@ -53,7 +57,8 @@ struct Server::Impl {
   void dispatch_fleet(const ParsedRequest& request, const dds::Request& raw,
                       const ReplyCache::Key& key);
   std::string fleet_reply(const ParsedRequest& request);
-  void send(const dds::Reply& reply);
+  /// Writes `reply` stamped with this server's shard.
+  void send(dds::Reply reply);
 
   ServerOptions options;
   ServerCounters counters;

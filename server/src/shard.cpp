@@ -15,6 +15,13 @@ std::uint64_t fnv1a64(std::string_view text) {
   return hash;
 }
 
+std::vector<std::string> Shard::foreign_vehicles(const std::vector<std::string>& vehicles) const {
+  std::vector<std::string> out;
+  for (const auto& v : vehicles)
+    if (!owns(v)) out.push_back(v);
+  return out;
+}
+
 Shard Shard::parse(std::string_view text) {
   const auto slash = text.find('/');
   Shard shard;

@@ -2,14 +2,21 @@
 // (RequestClient); `watch` reads the transient-local Estimate topic of a vehicle, so it shows
 // the latest estimates at once and every update after, for --seconds.
 //
-// Exit codes: 0 ok, 2 bad request (or bad command line), 3 not found, 4 the server failed,
-// 5 no server answered in time.
+// Several servers (dynid-server --shard K/N, docs/DESIGN.md "Scale-out"): a command naming a
+// vehicle is answered by the server of the vehicle's shard; `vehicles` and `status` ask every
+// server, wait until all N shards answered (N comes with the replies) or --timeout, and merge:
+// what the missing shards hold is left out, said on stderr, and the exit code is 6.
+//
+// Exit codes: 0 ok, 2 bad request (or bad command line), 3 not found, 4 the server failed (or
+// the servers disagree on the shard count), 5 no server answered in time, 6 some shards did
+// not answer (the output holds the others').
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdlib>
 #include <iostream>
 
 #include "dynid/cli/request_client.hpp"
+#include "dynid/cli/shard_replies.hpp"
 #include "dynid/dds/conversions.hpp"
 #include "dynid/dds/topics.hpp"
 #include "dynid/report/estimate_report.hpp"
@@ -43,12 +50,11 @@ int exit_code(dynid::dds::ReplyStatus status) {
   return 4;
 }
 
-int request(const Common& c, const std::string& kind, std::vector<RequestArgument> arguments) {
-  if (c.json) arguments.push_back({"format", "json"});
-  dynid::dds::Participant participant({c.domain, config_uri(c.config)});
-  dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
-  const auto timeout = std::chrono::milliseconds(static_cast<long long>(c.timeout_s * 1000));
-  const dynid::dds::Reply reply = client.call(kind, arguments, timeout);
+std::chrono::milliseconds timeout_of(const Common& c) {
+  return std::chrono::milliseconds(static_cast<long long>(c.timeout_s * 1000));
+}
+
+int print(const std::string& kind, const dynid::dds::Reply& reply) {
   if (reply.status != dynid::dds::ReplyStatus::kOk) {
     std::cerr << "dynid " << kind << ": " << reply.error << "\n";
     return exit_code(reply.status);
@@ -56,6 +62,29 @@ int request(const Common& c, const std::string& kind, std::vector<RequestArgumen
   std::cout << reply.payload;
   if (!reply.payload.empty() && reply.payload.back() != '\n') std::cout << "\n";
   return 0;
+}
+
+// A request every server answers (vehicles, status): one reply per shard, merged.
+int request_all(const Common& c, dynid::cli::RequestClient& client, const std::string& kind) {
+  // The vehicle lists are merged from JSON whatever the output format.
+  const std::vector<RequestArgument> arguments{{"format", "json"}};
+  const auto replies = client.call_all(kind, arguments, timeout_of(c));
+  if (const auto failure = replies.failure()) return print(kind, *failure);
+  std::cout << (kind == "status" ? dynid::cli::merged_status(replies)
+                                 : dynid::cli::render_vehicles(dynid::cli::merged_vehicles(replies), c.json));
+  if (kind == "status" || c.json) std::cout << "\n";
+  const std::string note = dynid::cli::missing_note(replies, timeout_of(c).count());
+  if (note.empty()) return 0;
+  std::cerr << "dynid " << kind << ": " << note << "\n";
+  return 6;
+}
+
+int request(const Common& c, const std::string& kind, std::vector<RequestArgument> arguments) {
+  dynid::dds::Participant participant({c.domain, config_uri(c.config)});
+  dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
+  if (kind == "vehicles" || kind == "status") return request_all(c, client, kind);
+  if (c.json) arguments.push_back({"format", "json"});
+  return print(kind, client.call(kind, arguments, timeout_of(c)));
 }
 
 int watch(const Common& c, const std::string& vehicle, double seconds) {
@@ -132,7 +161,8 @@ int main(int argc, char** argv) {
       "fleet", "one estimate over several vehicles: shared parameters common to all, the others per vehicle");
   fleet_cmd->add_option("model", model, "the model, e.g. longitudinal_wheel")->required();
   fleet_cmd->add_option("shared", shared, "parameters shared by the fleet")->required();
-  fleet_cmd->add_option("--vehicles", fleet_vehicles, "comma-separated vehicles (closed runs, else the latest)")
+  fleet_cmd->add_option("--vehicles", fleet_vehicles,
+                     "comma-separated vehicles (closed runs, else the latest), all of one shard")
       ->required();
   CLI11_PARSE(app, argc, argv);
   if (c.config.empty()) {
@@ -164,6 +194,9 @@ int main(int argc, char** argv) {
   } catch (const dynid::cli::NoServer& e) {
     std::cerr << "dynid: " << e.what() << "\n";
     return 5;
+  } catch (const dynid::cli::ShardMismatch& e) {
+    std::cerr << "dynid: " << e.what() << "\n";
+    return 4;
   } catch (const std::exception& e) {
     std::cerr << "dynid: " << e.what() << "\n";
     return 2;

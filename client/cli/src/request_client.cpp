@@ -19,10 +19,9 @@ std::string default_client_id() {
 RequestClient::RequestClient(const dds::Participant& participant, std::string client_id)
     : client_id_(std::move(client_id)), replies_(participant, {}), requests_(participant, {}) {}
 
-dds::Reply RequestClient::call(const std::string& kind,
-                               const std::vector<dds::RequestArgument>& arguments,
-                               std::chrono::milliseconds timeout,
-                               std::chrono::milliseconds resend) {
+bool RequestClient::exchange(const std::string& kind, const std::vector<dds::RequestArgument>& arguments,
+                             std::chrono::milliseconds timeout, std::chrono::milliseconds resend,
+                             const std::function<bool(const dds::Reply&)>& take) {
   using clock = std::chrono::steady_clock;
   const auto deadline = clock::now() + timeout;
   const auto left = [&] {
@@ -40,13 +39,47 @@ dds::Reply RequestClient::call(const std::string& kind,
     while (clock::now() < resend_at) {
       const auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(resend_at - clock::now());
       for (auto& received : replies_.wait_take(wait)) {
-        dds::Reply reply = dds::from_wire(received.data);
-        if (reply.client == client_id_ && reply.correlation_id == request.correlation_id) return reply;
+        const dds::Reply reply = dds::from_wire(received.data);
+        if (reply.client == client_id_ && reply.correlation_id == request.correlation_id && take(reply))
+          return true;
       }
     }
   }
-  throw NoServer("dynid-server did not answer '" + kind + "' within " +
-                 std::to_string(timeout.count()) + " ms");
+  return false;
+}
+
+dds::Reply RequestClient::call(const std::string& kind,
+                               const std::vector<dds::RequestArgument>& arguments,
+                               std::chrono::milliseconds timeout,
+                               std::chrono::milliseconds resend) {
+  dds::Reply first;
+  if (exchange(kind, arguments, timeout, resend, [&](const dds::Reply& reply) {
+        first = reply;
+        return true;
+      }))
+    return first;
+  std::string vehicle;
+  for (const auto& a : arguments)
+    if (a.name == "vehicle") vehicle = a.value;
+  throw NoServer(vehicle.empty()
+                     ? "dynid-server did not answer '" + kind + "' within " + std::to_string(timeout.count()) + " ms"
+                     : "no dynid-server answered '" + kind + "' for vehicle " + vehicle + " within " +
+                           std::to_string(timeout.count()) +
+                           " ms (only the server of the vehicle's shard answers: is it running?)");
+}
+
+ShardReplies RequestClient::call_all(const std::string& kind,
+                                     const std::vector<dds::RequestArgument>& arguments,
+                                     std::chrono::milliseconds timeout,
+                                     std::chrono::milliseconds resend) {
+  ShardReplies replies;
+  exchange(kind, arguments, timeout, resend, [&](const dds::Reply& reply) {
+    replies.add(reply);
+    return replies.complete();
+  });
+  if (replies.empty())
+    throw NoServer("dynid-server did not answer '" + kind + "' within " + std::to_string(timeout.count()) + " ms");
+  return replies;
 }
 
 }  // namespace dynid::cli

@@ -8,16 +8,23 @@
 //   every `resend` while no reply came (a reply written before the server had discovered our
 //   reader is lost; the server answers a repeat from its reply cache, it does not run the
 //   request twice).
+// - call_all() is for the requests every server answers (vehicles, status): it collects one
+//   reply per shard (ShardReplies: the shard count comes with the replies), resending while
+//   a shard is missing, and returns when all answered or at `timeout` with those that did.
+//   A request naming a vehicle is answered by its shard's server alone: call() takes the
+//   first reply.
 // - Every wait is bounded by `timeout`: NoServer is thrown, with a message saying what was
 //   waited for and what to check, when no server matched or none answered in time.
 // - The Participant must outlive the client.
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "dynid.h"
+#include "dynid/cli/shard_replies.hpp"
 #include "dynid/dds/participant.hpp"
 #include "dynid/dds/reader.hpp"
 #include "dynid/dds/request.hpp"
@@ -41,9 +48,21 @@ class RequestClient {
                   std::chrono::milliseconds timeout,
                   std::chrono::milliseconds resend = std::chrono::milliseconds(1000));
 
+  /// The replies of every shard that answered within `timeout` (at least one, else NoServer);
+  /// ShardMismatch when servers disagree on the shard count.
+  ShardReplies call_all(const std::string& kind, const std::vector<dds::RequestArgument>& arguments,
+                        std::chrono::milliseconds timeout,
+                        std::chrono::milliseconds resend = std::chrono::milliseconds(1000));
+
   const std::string& client_id() const { return client_id_; }
 
  private:
+  /// Sends the request (again every `resend`) and hands each reply to it to `take` until
+  /// `take` returns true (true) or `timeout` passes (false). NoServer when none matched.
+  bool exchange(const std::string& kind, const std::vector<dds::RequestArgument>& arguments,
+                std::chrono::milliseconds timeout, std::chrono::milliseconds resend,
+                const std::function<bool(const dds::Reply&)>& take);
+
   std::string client_id_;
   std::uint64_t next_correlation_ = 1;
   dds::Reader<dynid_wire_Reply> replies_;  // before the writer: ready when the request leaves

@@ -1,0 +1,99 @@
+#include "dynid/cli/shard_replies.hpp"
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+#include "dynid/error.hpp"
+
+namespace dynid::cli {
+
+namespace {
+
+using nlohmann::ordered_json;
+
+std::string name_of(const dds::Reply& reply) { return shard_name(reply.shard, reply.shard_count); }
+
+ordered_json parse_payload(const dds::Reply& reply, const std::string& what) {
+  try {
+    return ordered_json::parse(reply.payload);
+  } catch (const ordered_json::parse_error& e) {
+    throw InputError(what + " of shard " + name_of(reply) + ": not JSON (" + e.what() + ")");
+  }
+}
+
+}  // namespace
+
+std::string shard_name(std::uint32_t index, std::uint32_t count) {
+  return std::to_string(index) + "/" + std::to_string(count);
+}
+
+bool ShardReplies::add(const dds::Reply& received) {
+  dds::Reply reply = received;
+  if (reply.shard_count == 0) {  // a server that does not say: the only one
+    reply.shard = 0;
+    reply.shard_count = 1;
+  }
+  if (count_ == 0) count_ = reply.shard_count;
+  if (reply.shard_count != count_)
+    throw ShardMismatch("the servers disagree on the number of shards: shard " + name_of(reply) +
+                        " answered after shard " + name_of(replies_.begin()->second) +
+                        "; start every dynid-server of the domain with the same --shard K/N");
+  return replies_.emplace(reply.shard, std::move(reply)).second;
+}
+
+std::vector<std::uint32_t> ShardReplies::missing() const {
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t k = 0; k < count_; ++k)
+    if (!replies_.count(k)) out.push_back(k);
+  return out;
+}
+
+std::optional<dds::Reply> ShardReplies::failure() const {
+  for (const auto& [index, reply] : replies_)
+    if (reply.status != dds::ReplyStatus::kOk) return reply;
+  return std::nullopt;
+}
+
+std::vector<std::string> merged_vehicles(const ShardReplies& replies) {
+  std::vector<std::string> out;
+  for (const auto& [index, reply] : replies.replies()) {
+    const auto list = parse_payload(reply, "vehicle list");
+    if (!list.is_array()) throw InputError("vehicle list of shard " + name_of(reply) + ": not a JSON array");
+    for (const auto& v : list) {
+      if (!v.is_string())
+        throw InputError("vehicle list of shard " + name_of(reply) + ": " + v.dump() + " is not a vehicle id");
+      out.push_back(v.get<std::string>());
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+std::string render_vehicles(const std::vector<std::string>& vehicles, bool json) {
+  if (json) return ordered_json(vehicles).dump();
+  std::string text;
+  for (const auto& v : vehicles) text += v + "\n";
+  return text;
+}
+
+std::string merged_status(const ShardReplies& replies) {
+  if (replies.count() == 1 && replies.complete()) return replies.replies().begin()->second.payload;
+  ordered_json out = {{"shards", ordered_json::object()}, {"missing", ordered_json::array()}};
+  for (const auto& [index, reply] : replies.replies())
+    out["shards"][name_of(reply)] = parse_payload(reply, "status");
+  for (const auto index : replies.missing()) out["missing"].push_back(shard_name(index, replies.count()));
+  return out.dump();
+}
+
+std::string missing_note(const ShardReplies& replies, std::int64_t timeout_ms) {
+  const auto missing = replies.missing();
+  if (missing.empty()) return {};
+  std::string names;
+  for (const auto index : missing) names += (names.empty() ? "" : ", ") + shard_name(index, replies.count());
+  return (missing.size() == 1 ? "shard " + names + " did not" : "shards " + names + " did not") +
+         " answer within " + std::to_string(timeout_ms) + " ms: " +
+         (missing.size() == 1 ? "its" : "their") + " vehicles are not included";
+}
+
+}  // namespace dynid::cli
