@@ -142,20 +142,23 @@ std::string Statement::column_blob(int index) const {
               : std::string();
 }
 
-Transaction::Transaction(Database& db) : db_(db) {
-  db_.exec("BEGIN IMMEDIATE", "begin");
+Transaction::Transaction(Database& db)
+    : db_(db), nested_(sqlite3_get_autocommit(db.handle()) == 0) {
+  db_.exec(nested_ ? "SAVEPOINT dynid_nested" : "BEGIN IMMEDIATE", "begin");
 }
 
 Transaction::~Transaction() {
   // SQLite may already have rolled back by itself (e.g. after SQLITE_FULL or an I/O error);
   // only roll back a transaction that is still open, and never throw from here.
   if (open_ && !sqlite3_get_autocommit(db_.handle())) {
-    sqlite3_exec(db_.handle(), "ROLLBACK", nullptr, nullptr, nullptr);
+    sqlite3_exec(db_.handle(),
+                 nested_ ? "ROLLBACK TO dynid_nested; RELEASE dynid_nested" : "ROLLBACK", nullptr,
+                 nullptr, nullptr);
   }
 }
 
 void Transaction::commit() {
-  db_.exec("COMMIT", "commit");
+  db_.exec(nested_ ? "RELEASE dynid_nested" : "COMMIT", "commit");
   open_ = false;
 }
 

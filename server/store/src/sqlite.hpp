@@ -87,17 +87,21 @@ class Query {
 
 /// BEGIN IMMEDIATE ... COMMIT. Immediate so the write lock is taken up front (no upgrade
 /// failure half-way). Rolls back in the destructor unless commit() succeeded.
+/// Inside an open transaction (Store::batch) it is a savepoint instead: commit() releases it
+/// into the enclosing transaction (durable only when that one commits), and the destructor
+/// rolls back this part alone, so one refused write does not undo the others of the batch.
 class Transaction {
  public:
   explicit Transaction(Database& db);
   ~Transaction();
   Transaction(const Transaction&) = delete;
   Transaction& operator=(const Transaction&) = delete;
-  /// COMMIT; with synchronous=FULL the WAL is fsync'd before this returns.
+  /// COMMIT; with synchronous=FULL the WAL is fsync'd before this returns. Nested: RELEASE.
   void commit();
 
  private:
   Database& db_;
+  bool nested_;
   bool open_ = true;
 };
 

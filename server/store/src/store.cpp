@@ -1,5 +1,7 @@
 #include "dynid/store/store.hpp"
 
+#include <sqlite3.h>
+
 #include <map>
 #include <utility>
 
@@ -175,6 +177,14 @@ void Store::close_run(const RunKey& key) {
   s.close.start().bind(1, run_id).bind(2, now_ns()).run();
   transaction.commit();
   s.runs.at(key).closed = true;
+}
+
+void Store::batch(const std::function<void(Store&)>& f) {
+  if (!sqlite3_get_autocommit(impl_->db.handle()))
+    throw InputError("store " + impl_->db.path() + ": batch() inside a batch");
+  detail::Transaction transaction(impl_->db);
+  f(*this);
+  transaction.commit();
 }
 
 // ---- listings and estimates -------------------------------------------------------------

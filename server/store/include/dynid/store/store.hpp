@@ -11,6 +11,12 @@
 // rolled back and leaves nothing half-written. A full disk (SQLITE_FULL) or an I/O error is a
 // StoreError naming the file; the chunk is then not stored and must not be acknowledged.
 //
+// Group commit (batch). batch(f) runs f inside one transaction: every write f makes is then a
+// savepoint of it (a write that throws is rolled back alone, as above; the others stay), and
+// all of them become durable together, with one fsync, when batch() returns. Inside a batch a
+// write that returned is NOT durable yet: acknowledge nothing before batch() has returned. If
+// f throws, or the commit fails (StoreError), everything f wrote is rolled back.
+//
 // Ordering (store_chunk). Sequences of a run start at 0. The ledger keeps the highest
 // *contiguous* sequence stored: every sequence 0..c is stored. The acknowledgement is that c,
 // never a sequence past a gap. A chunk past the gap (a resend overtook a lost chunk) is stored
@@ -44,6 +50,7 @@
 //
 // One Store per file and process (the server owns it); not thread-safe: one thread at a time.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -158,6 +165,10 @@ class Store {
   std::vector<RunInfo> list_runs(const std::string& vehicle);
   /// No new chunk is accepted afterwards (duplicates still re-acknowledge). Idempotent.
   void close_run(const RunKey& run);
+  /// Runs f(*this) as one transaction (see Group commit above); InputError inside a batch.
+  /// Meant for the chunk path's writes (store_chunk, mark_folded, save_checkpoint,
+  /// record_estimate): close_run's and add_run's run cache is not rolled back with it.
+  void batch(const std::function<void(Store&)>& f);
 
  private:
   struct Impl;
