@@ -3,6 +3,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 #include "dynid/dds/conversions.hpp"
 #include "dynid/report/estimate_report.hpp"
 
@@ -12,6 +14,7 @@ namespace {
 
 constexpr std::size_t kMaxRejectionsKept = 64;  // = dynid_wire_kMaxRejections
 constexpr std::uint64_t kReplayBatch = 16;      // chunks read from the store per lock
+constexpr std::size_t kMaxBatch = 256;          // chunks stored per transaction at most
 
 std::string label(const store::RunKey& key) { return key.vehicle + "/" + key.run; }
 
@@ -66,7 +69,8 @@ RunService::RunState& RunService::load_from_store(const store::RunKey& key) {
   state->contiguous = contiguous;
   RunState& run = *runs_.emplace(key, std::move(state)).first->second;
   const std::uint64_t from = run.processor.next_sequence();
-  fold_ready(key, run, nullptr);
+  fold_ready(key, run, {});
+  save_folds({key});
   if (closed && !run.processor.finished()) run.processor.finish();
   spdlog::info("run {}: resumed at #{} ({} stored contiguously{})", label(key), from,
                run.contiguous + 1, closed ? ", closed" : "");
@@ -75,6 +79,7 @@ RunService::RunState& RunService::load_from_store(const store::RunKey& key) {
 }
 
 void RunService::resume(const store::RunKey& key) {
+  flush_pending();
   try {
     load(key);
   } catch (const std::exception& e) {
@@ -85,6 +90,7 @@ void RunService::resume(const store::RunKey& key) {
 // ---- announcements -----------------------------------------------------------------
 
 void RunService::announce(const ingest::RunAnnouncement& announcement) {
+  flush_pending();
   const store::RunKey key{announcement.vehicle, announcement.run};
   try {
     // The processor validates the models too (unknown model, bad constant, wrong unit), so a
@@ -126,6 +132,7 @@ void RunService::reject(const store::RunKey& key, RunState* run, std::uint64_t s
 
 void RunService::reject_unreadable(const std::string& vehicle, const std::string& run,
                                    std::uint64_t sequence, const std::string& reason) {
+  flush_pending();
   const store::RunKey key{vehicle, run};
   reject(key, find(key), sequence, reason);
 }
@@ -145,39 +152,71 @@ void RunService::receive_chunk(const ingest::Chunk& chunk) {
   } catch (const InputError& e) {
     return reject(key, run, chunk.sequence, e.what());
   }
-  if (store_and_ack(key, *run, chunk)) fold_ready(key, *run, &chunk);
+  pending_.push_back({key, chunk});
+  if (pending_.size() >= kMaxBatch) flush_pending();
 }
 
-// Stores the chunk durably, then acknowledges; false when nothing new was stored.
-bool RunService::store_and_ack(const store::RunKey& key, RunState& run,
-                               const ingest::Chunk& chunk) {
-  store::StoreChunkResult result;
+void RunService::flush_pending() {
+  if (pending_.empty()) return;
+  std::vector<PendingChunk> batch;
+  batch.swap(pending_);
+  const auto results = store_batch(batch);
+  if (results.empty()) return;  // not stored: nothing acknowledged, the cars resend
+  std::vector<store::RunKey> touched;  // runs with news, in arrival order
+  std::map<store::RunKey, std::vector<const ingest::Chunk*>> stored;
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    const store::RunKey& key = batch[i].key;
+    RunState& run = *find(key);  // loaded by receive_chunk; runs are never unloaded
+    if (const auto* refused = std::get_if<std::string>(&results[i])) {
+      reject(key, &run, batch[i].chunk.sequence, *refused);
+      continue;
+    }
+    const auto& result = std::get<store::StoreChunkResult>(results[i]);
+    run.contiguous = as_mark(result.contiguous_through);
+    if (result.status == store::ChunkStatus::conflict ||
+        result.status == store::ChunkStatus::beyond_window) {
+      reject(key, &run, batch[i].chunk.sequence, result.reason);
+      continue;
+    }
+    const bool is_new = result.status == store::ChunkStatus::stored;
+    context_.counters.add(is_new ? &CounterSnapshot::chunks_stored : &CounterSnapshot::chunks_duplicate);
+    if (is_new) stored[key].push_back(&batch[i].chunk);
+    if (std::find(touched.begin(), touched.end(), key) == touched.end()) touched.push_back(key);
+  }
+  // Durable now (the batch committed): acknowledge each run once, with its highest mark.
+  for (const auto& key : touched) publish_ack(key, find(key));
+  for (const auto& key : touched) fold_ready(key, *find(key), stored[key]);
+  // Their folded marks and checkpoints ride with the next batch's transaction (or the next
+  // idle tick's): one fsync per batch, not two.
+  for (const auto& key : touched)
+    if (std::find(unsaved_.begin(), unsaved_.end(), key) == unsaved_.end()) unsaved_.push_back(key);
+}
+
+// Stores the chunks in one transaction (one fsync); per chunk its result or the reason it was
+// refused (e.g. the run is closed). Empty when the batch could not be committed.
+std::vector<std::variant<store::StoreChunkResult, std::string>> RunService::store_batch(
+    const std::vector<PendingChunk>& batch) {
+  std::vector<std::variant<store::StoreChunkResult, std::string>> results(batch.size());
   try {
-    result = context_.store.with([&](store::Store& s) { return s.store_chunk(chunk); });
-  } catch (const InputError& e) {  // e.g. the run is closed
-    reject(key, &run, chunk.sequence, e.what());
-    return false;
-  } catch (const store::StoreError& e) {  // nothing stored: acknowledge nothing
-    context_.counters.add(&CounterSnapshot::store_errors);
-    spdlog::error("chunk {}#{} not stored: {}", label(key), chunk.sequence, e.what());
-    return false;
+    context_.store.with([&](store::Store& s) {
+      s.batch([&](store::Store& b) {
+        save_unsaved(b);
+        for (std::size_t i = 0; i < batch.size(); ++i) {
+          try {
+            results[i] = b.store_chunk(batch[i].chunk);
+          } catch (const InputError& e) {  // rolled back alone; the others stay
+            results[i] = std::string(e.what());
+          }
+        }
+      });
+    });
+  } catch (const store::StoreError& e) {
+    context_.counters.add(&CounterSnapshot::store_errors, batch.size());
+    spdlog::error("{} chunks not stored ({}#{}..): {}", batch.size(), label(batch.front().key),
+                  batch.front().chunk.sequence, e.what());
+    return {};
   }
-  run.contiguous = as_mark(result.contiguous_through);
-  switch (result.status) {
-    case store::ChunkStatus::stored:
-      context_.counters.add(&CounterSnapshot::chunks_stored);
-      publish_ack(key, &run);
-      return true;
-    case store::ChunkStatus::duplicate:
-      context_.counters.add(&CounterSnapshot::chunks_duplicate);
-      publish_ack(key, &run);  // the first ack may have been lost
-      return false;
-    case store::ChunkStatus::conflict:
-    case store::ChunkStatus::beyond_window:
-      reject(key, &run, chunk.sequence, result.reason);
-      return false;
-  }
-  return false;
+  return results;
 }
 
 std::vector<ingest::Chunk> RunService::read_chunks(const store::RunKey& key, std::uint64_t from,
@@ -190,21 +229,26 @@ std::vector<ingest::Chunk> RunService::read_chunks(const store::RunKey& key, std
   });
 }
 
-// Folds next_sequence()..contiguous in order: the chunk in hand when it is the next one,
-// otherwise what the store holds (replay after a restart, chunks that were stored ahead).
-void RunService::fold_ready(const store::RunKey& key, RunState& run, const ingest::Chunk* in_hand) {
+// The next chunk to fold: from the chunks in hand when there, else read from the store with
+// the ones after it (replay after a restart, chunks that were stored ahead of a gap).
+std::vector<ingest::Chunk> RunService::next_chunks(const store::RunKey& key, const RunState& run,
+                                                   const std::vector<const ingest::Chunk*>& in_hand) {
+  const std::uint64_t next = run.processor.next_sequence();
+  for (const ingest::Chunk* chunk : in_hand)
+    if (chunk->sequence == next) return {*chunk};
+  auto batch = read_chunks(key, next, std::min<std::uint64_t>(next + kReplayBatch - 1, static_cast<std::uint64_t>(run.contiguous)));
+  context_.counters.add(&CounterSnapshot::chunks_replayed, batch.size());
+  return batch;
+}
+
+// Folds next_sequence()..contiguous in order; the folded mark and a due checkpoint are kept in
+// the run for save_folds().
+void RunService::fold_ready(const store::RunKey& key, RunState& run,
+                            const std::vector<const ingest::Chunk*>& in_hand) {
   if (!run.halted.empty() || run.processor.finished()) return;
   const std::uint64_t first = run.processor.next_sequence();
   while (run.contiguous >= 0 && run.processor.next_sequence() <= static_cast<std::uint64_t>(run.contiguous)) {
-    const std::uint64_t next = run.processor.next_sequence();
-    std::vector<ingest::Chunk> batch;
-    if (in_hand && in_hand->sequence == next) {
-      batch.push_back(*in_hand);
-    } else {
-      batch = read_chunks(key, next, std::min<std::uint64_t>(next + kReplayBatch - 1, static_cast<std::uint64_t>(run.contiguous)));
-      context_.counters.add(&CounterSnapshot::chunks_replayed, batch.size());
-    }
-    for (const auto& chunk : batch) {
+    for (const auto& chunk : next_chunks(key, run, in_hand)) {
       try {
         run.processor.push(chunk);
       } catch (const InputError& e) {
@@ -215,29 +259,65 @@ void RunService::fold_ready(const store::RunKey& key, RunState& run, const inges
       }
       context_.counters.add(&CounterSnapshot::chunks_folded);
       run.dirty = true;
-      if (++run.since_checkpoint >= context_.options.checkpoint_every) checkpoint(key, run);
+      if (++run.since_checkpoint >= context_.options.checkpoint_every) take_checkpoint(key, run);
     }
     if (!run.halted.empty()) break;
   }
   const std::uint64_t after = run.processor.next_sequence();
-  if (after > first)
-    context_.store.with([&](store::Store& s) { s.mark_folded(key, after - 1); });
+  if (after > first) run.unsaved_fold = after - 1;
 }
 
-// A checkpoint only shortens a later replay: when it cannot be saved (a full disk, or a mark
-// below a damaged newer checkpoint after a rebuild from #0), the run goes on without it.
-void RunService::checkpoint(const store::RunKey& key, RunState& run) {
-  const std::uint64_t through = run.processor.next_sequence() - 1;
+// The state right after this chunk, saved with the folded mark (every one of them: each is an
+// entry of the estimate history).
+void RunService::take_checkpoint(const store::RunKey& key, RunState& run) {
   run.since_checkpoint = 0;
   try {
-    const std::string state = run.processor.checkpoint();
-    context_.store.with([&](store::Store& s) { s.save_checkpoint(key, through, state); });
+    run.unsaved_checkpoints.push_back({run.processor.next_sequence() - 1, run.processor.checkpoint(),
+                                       tables_of(key.vehicle, key.run, run.processor.estimates())});
   } catch (const std::exception& e) {
-    spdlog::error("run {}: checkpoint through #{} not saved: {}", label(key), through, e.what());
-    return;
+    spdlog::error("run {}: no checkpoint: {}", label(key), e.what());
   }
-  context_.counters.add(&CounterSnapshot::checkpoints);
-  record_history(key, tables_of(key.vehicle, key.run, run.processor.estimates()));
+}
+
+// The runs' folded marks and due checkpoints, in one transaction. A checkpoint only shortens
+// a later replay: when it cannot be saved (a full disk, or a mark below a damaged newer
+// checkpoint after a rebuild from #0), the run goes on without it. A folded mark that is not
+// saved is harmless too: opening the store resets the marks to the checkpoints.
+void RunService::save_folds(const std::vector<store::RunKey>& keys) {
+  try {
+    context_.store.with([&](store::Store& s) {
+      s.batch([&](store::Store& b) {
+        for (const auto& key : keys) save_fold(b, key, *find(key));
+      });
+    });
+  } catch (const std::exception& e) {
+    spdlog::error("folded marks and checkpoints of {} runs not saved: {}", keys.size(), e.what());
+  }
+}
+
+// Inside a batch: the marks and checkpoints flush_pending left for later. Should the batch
+// not commit, they are lost, which only lengthens a replay after a restart.
+void RunService::save_unsaved(store::Store& s) {
+  for (const auto& key : std::exchange(unsaved_, {})) save_fold(s, key, *find(key));
+}
+
+void RunService::save_fold(store::Store& s, const store::RunKey& key, RunState& run) {
+  for (const auto& checkpoint : std::exchange(run.unsaved_checkpoints, {})) {
+    try {
+      s.save_checkpoint(key, checkpoint.through, checkpoint.state);
+      context_.counters.add(&CounterSnapshot::checkpoints);
+      record_history(s, key, checkpoint.tables);
+    } catch (const InputError& e) {
+      spdlog::error("run {}: checkpoint through #{} not saved: {}", label(key), checkpoint.through, e.what());
+    }
+  }
+  if (const auto mark = std::exchange(run.unsaved_fold, std::nullopt)) {
+    try {
+      s.mark_folded(key, *mark);
+    } catch (const InputError& e) {
+      spdlog::error("run {}: folded mark #{} not saved: {}", label(key), *mark, e.what());
+    }
+  }
 }
 
 // ---- publication -------------------------------------------------------------------------
@@ -271,6 +351,8 @@ void RunService::publish_tables(const std::string& vehicle, EstimateTables table
 }
 
 void RunService::publish_due(std::chrono::steady_clock::time_point now) {
+  flush_pending();
+  if (!unsaved_.empty()) save_folds(std::exchange(unsaved_, {}));  // idle: nothing to ride on
   for (auto& [key, run] : runs_) {
     if (!run->dirty || now - run->last_published < context_.options.publish_interval) continue;
     try {
@@ -282,13 +364,16 @@ void RunService::publish_due(std::chrono::steady_clock::time_point now) {
 }
 
 void RunService::record_history(const store::RunKey& key, const EstimateTables& tables) {
+  context_.store.with([&](store::Store& s) { record_history(s, key, tables); });
+}
+
+void RunService::record_history(store::Store& s, const store::RunKey& key,
+                                const EstimateTables& tables) {
   const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
                        std::chrono::system_clock::now().time_since_epoch())
                        .count();
-  context_.store.with([&](store::Store& s) {
-    for (const auto& table : tables.tables)
-      s.record_estimate({key.vehicle, table.model, key.run, now, report::estimate_json(table)});
-  });
+  for (const auto& table : tables.tables)
+    s.record_estimate({key.vehicle, table.model, key.run, now, report::estimate_json(table)});
 }
 
 }  // namespace dynid::server

@@ -90,6 +90,7 @@ std::string RunService::latest_run(const std::string& vehicle) {
 EstimateTables RunService::estimate(const std::string& vehicle,
                                     const std::optional<std::string>& run,
                                     const std::optional<std::string>& model) {
+  flush_pending();  // the chunks received before this request count
   const store::RunKey key{vehicle, run ? *run : latest_run(vehicle)};
   const RunState& state = load(key);
   auto tables = tables_of(vehicle, key.run, state.processor.estimates(), model);
@@ -101,6 +102,7 @@ EstimateTables RunService::estimate(const std::string& vehicle,
 
 EstimateTables RunService::pooled(const std::string& vehicle, const std::vector<std::string>& runs,
                                   const std::optional<std::string>& model) {
+  flush_pending();  // the chunks received before this request count
   if (runs.empty()) throw InputError("pooled: name at least one run");
   if (std::set<std::string>(runs.begin(), runs.end()).size() != runs.size())
     throw InputError("pooled: a run is named twice (" + join(runs, ", ") + ")");
@@ -130,6 +132,7 @@ EstimateTables RunService::pooled(const std::string& vehicle, const std::vector<
 }
 
 FleetSource RunService::fleet_member(const std::string& vehicle, const std::string& model) {
+  flush_pending();  // the chunks received before this request count
   latest_run(vehicle);  // NotFound for an unknown vehicle or one without runs
   const auto stored = context_.store.with([&](store::Store& s) { return s.list_runs(vehicle); });
   FleetSource out;
@@ -154,6 +157,7 @@ FleetSource RunService::fleet_member(const std::string& vehicle, const std::stri
 }
 
 EstimateTables RunService::close(const std::string& vehicle, const std::string& run) {
+  flush_pending();  // the chunks received before this request count
   const store::RunKey key{vehicle, run};
   RunState& state = load(key);
   if (!state.processor.finished()) state.processor.finish();  // folds the held-back samples
@@ -168,6 +172,7 @@ EstimateTables RunService::close(const std::string& vehicle, const std::string& 
 EstimateTables RunService::reprocess(const std::string& vehicle, const std::string& run,
                                      const std::string& model,
                                      const std::vector<std::string>& effects) {
+  flush_pending();  // the chunks received before this request count
   const store::RunKey key{vehicle, run};
   const RunState& state = load(key);
   ingest::RunAnnouncement announcement = state.processor.announcement();
@@ -188,6 +193,7 @@ EstimateTables RunService::reprocess(const std::string& vehicle, const std::stri
 
 std::string RunService::base_report(const std::string& vehicle, const std::string& run,
                                     const std::string& model, bool json) {
+  flush_pending();  // the chunks received before this request count
   const RunState& state = load({vehicle, run});
   const auto estimates = state.processor.estimates();
   const std::size_t m = model_index(estimates, model);
@@ -218,6 +224,7 @@ std::string RunService::base_report(const std::string& vehicle, const std::strin
 }
 
 std::string RunService::list_runs(const std::string& vehicle, bool json) {
+  flush_pending();  // the chunks received before this request count
   latest_run(vehicle);  // NotFound for an unknown vehicle or one without runs
   const auto runs = context_.store.with([&](store::Store& s) { return s.list_runs(vehicle); });
   std::string text = fmt::format("{:<24} {:<7} {:>10} {:>10} {:>8}\n", "run", "state", "stored", "folded", "chunks");

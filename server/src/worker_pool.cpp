@@ -37,23 +37,26 @@ void WorkerPool::post(std::size_t worker, Task task) {
 void WorkerPool::run(std::size_t worker) {
   Queue& q = *queues_[worker];
   for (;;) {
-    Task task;
+    std::deque<Task> batch;
     {
       std::unique_lock lock(q.mutex);
       q.changed.wait_for(lock, tick_period_, [&] { return !q.tasks.empty() || q.stopping; });
       if (q.tasks.empty() && q.stopping) return;
-      if (!q.tasks.empty()) {
-        task = std::move(q.tasks.front());
-        q.tasks.pop_front();
-        q.changed.notify_all();  // room for a blocked post()
-      }
+      batch.swap(q.tasks);  // everything queued: one tick for all (the server's group commit)
+      q.changed.notify_all();  // room for blocked post()s
     }
-    try {
-      if (task) task();
+    for (auto& task : batch) run_task(worker, task);
+    run_task(worker, [this, worker] {
       if (tick_) tick_(worker);
-    } catch (const std::exception& e) {
-      spdlog::error("worker {}: task failed: {}", worker, e.what());
-    }
+    });
+  }
+}
+
+void WorkerPool::run_task(std::size_t worker, const Task& task) {
+  try {
+    task();
+  } catch (const std::exception& e) {
+    spdlog::error("worker {}: task failed: {}", worker, e.what());
   }
 }
 

@@ -4,17 +4,22 @@
 // run-level requests. One per worker; only that worker's thread calls it, so it needs no lock
 // of its own (the store is shared through SharedStore).
 //
-// Chunk path, per chunk (receive_chunk):
-//   validate_chunk against the run's announcement -> store_chunk (durable: fsync'd)
-//   -> publish the ChunkAck (highest contiguous stored, recent rejections with reasons)
+// Chunk path, with group commit: receive_chunk validates the chunk against the run's
+// announcement and queues it; flush_pending(), at the end of the worker's batch of tasks
+// (publish_due, the worker's tick), before any other call (so a request or announcement sees
+// every chunk received before it), and every kMaxBatch chunks, then:
+//   store the queued chunks in one transaction (Store::batch: durable with one fsync)
+//   -> publish one ChunkAck per run (highest contiguous stored, recent rejections with reasons)
 //   -> fold every stored contiguous chunk not yet folded, in sequence order (a chunk stored
-//      ahead of a gap is folded when the gap closes) -> mark them folded in the ledger
-//   -> every `checkpoint_every` folded chunks: save the RunProcessor's checkpoint
+//      ahead of a gap is folded when the gap closes)
+//   -> the folded marks, and a checkpoint every `checkpoint_every` folded chunks of a run (the
+//      state taken right after that chunk, with its estimate history entry), are saved in the next
+//      batch's transaction, or on the next tick when no chunk came: one fsync per batch
 //   -> the run's estimates are published at most every `publish_interval` (publish_due).
-// A chunk is acknowledged only once store_chunk returned: never before it is durable. A
+// A chunk is acknowledged only once its batch has committed: never before it is durable. A
 // rejected chunk (unknown run, invalid, conflicting, too far ahead, closed run) is counted,
 // listed in the ack with its reason, and changes no state. A store failure acknowledges
-// nothing (the car resends).
+// nothing of the batch (the cars resend).
 //
 // Restart (resume): the latest checkpoint is restored (a damaged one is reported and the run
 // rebuilt from #0), the stored chunks after it are replayed, and the ledger's folded mark
@@ -31,6 +36,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "dynid/dds/chunk_receipt.hpp"
@@ -80,8 +86,11 @@ class RunService {
   void reject_unreadable(const std::string& vehicle, const std::string& run,
                          std::uint64_t sequence, const std::string& reason);
   void resume(const store::RunKey& key);
-  /// Publishes the estimates of runs that changed and whose interval has passed.
+  /// The worker's tick: stores, acknowledges and folds the queued chunks (flush_pending), then
+  /// publishes the estimates of runs that changed and whose interval has passed.
   void publish_due(std::chrono::steady_clock::time_point now);
+  /// Stores, acknowledges and folds the chunks receive_chunk queued (see above).
+  void flush_pending();
 
   // Run-level requests. InputError/NotFound name what is wrong.
   EstimateTables estimate(const std::string& vehicle, const std::optional<std::string>& run,
@@ -100,6 +109,11 @@ class RunService {
   std::string list_runs(const std::string& vehicle, bool json);
 
  private:
+  struct UnsavedCheckpoint {
+    std::uint64_t through = 0;
+    std::string state;
+    EstimateTables tables;  // for the estimate history
+  };
   struct RunState {
     explicit RunState(ingest::RunProcessor p) : processor(std::move(p)) {}
     ingest::RunProcessor processor;
@@ -109,6 +123,12 @@ class RunService {
     std::string halted;
     bool dirty = false;
     std::chrono::steady_clock::time_point last_published{};
+    std::optional<std::uint64_t> unsaved_fold;  // folded through, not yet in the ledger
+    std::vector<UnsavedCheckpoint> unsaved_checkpoints;
+  };
+  struct PendingChunk {
+    store::RunKey key;
+    ingest::Chunk chunk;
   };
 
   RunState* find(const store::RunKey& key);
@@ -120,18 +140,28 @@ class RunService {
               const std::string& reason);
   void publish_ack(const store::RunKey& key, const RunState* run,
                    const std::vector<dds::ChunkRejection>& extra = {});
-  bool store_and_ack(const store::RunKey& key, RunState& run, const ingest::Chunk& chunk);
-  void fold_ready(const store::RunKey& key, RunState& run, const ingest::Chunk* in_hand);
+  std::vector<std::variant<store::StoreChunkResult, std::string>> store_batch(
+      const std::vector<PendingChunk>& batch);
+  void fold_ready(const store::RunKey& key, RunState& run,
+                  const std::vector<const ingest::Chunk*>& in_hand);
+  std::vector<ingest::Chunk> next_chunks(const store::RunKey& key, const RunState& run,
+                                         const std::vector<const ingest::Chunk*>& in_hand);
   std::vector<ingest::Chunk> read_chunks(const store::RunKey& key, std::uint64_t from,
                                          std::uint64_t to);
-  void checkpoint(const store::RunKey& key, RunState& run);
+  void take_checkpoint(const store::RunKey& key, RunState& run);
+  void save_folds(const std::vector<store::RunKey>& keys);
+  void save_fold(store::Store& s, const store::RunKey& key, RunState& run);
+  void save_unsaved(store::Store& s);
   void publish(const store::RunKey& key, RunState& run);
   void publish_tables(const std::string& vehicle, EstimateTables tables);
   void record_history(const store::RunKey& key, const EstimateTables& tables);
+  void record_history(store::Store& s, const store::RunKey& key, const EstimateTables& tables);
   std::string latest_run(const std::string& vehicle);
 
   ServerContext& context_;
   std::map<store::RunKey, std::unique_ptr<RunState>> runs_;
+  std::vector<PendingChunk> pending_;  // received, validated, not yet stored
+  std::vector<store::RunKey> unsaved_;  // runs whose folded mark or checkpoint is not saved
   VehicleOutputs outputs_;
 };
 

@@ -7,8 +7,10 @@
 // Contract:
 // - post() enqueues; when the worker's queue holds `max_queue` tasks it blocks until there is
 //   room (back-pressure to the DDS reader, whose keep-all limits then hold the cars back).
-// - Between tasks, and at least every `tick_period` when idle, a worker calls tick(worker)
-//   (the server publishes throttled estimates there).
+// - A worker takes every task queued at once, runs them in order, then calls tick(worker)
+//   once; idle, it calls tick at least every `tick_period`. The server stores the chunks of
+//   such a batch in one transaction and publishes throttled estimates there, so a busy worker
+//   commits many chunks per fsync and an idle one commits each chunk on its own.
 // - A task that throws is logged and dropped; the worker goes on.
 // - stop() lets every worker finish the tasks already queued, then joins them. Idempotent;
 //   the destructor calls it.
@@ -49,6 +51,7 @@ class WorkerPool {
     bool stopping = false;
   };
   void run(std::size_t worker);
+  static void run_task(std::size_t worker, const Task& task);  // logs and drops a throw
 
   std::size_t max_queue_;
   std::chrono::milliseconds tick_period_;
