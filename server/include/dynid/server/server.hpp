@@ -14,7 +14,11 @@
 // Contract:
 // - The constructor opens the store, joins the domain with options.cyclone_config (required,
 //   never Cyclone's default), starts the workers and queues the resumption of every open run
-//   of this shard. StoreError/CorruptionError/DdsError/InputError on failure.
+//   of this shard. StoreError/CorruptionError/DdsError/InputError on failure; InputError too
+//   when the store holds vehicles another shard owns (shard.hpp).
+// - Several servers (options.shard K/N): samples of vehicles of other shards are dropped;
+//   requests naming a vehicle are answered by its owner only, vehicles/status by every
+//   shard, and every reply carries the shard (docs/DESIGN.md, "Scale-out").
 // - run() dispatches until stop(); stop() may be called from any thread (not from a signal
 //   handler: main.cpp waits for signals with sigwait). After run() returns, the destructor
 //   lets the workers finish what is queued.
