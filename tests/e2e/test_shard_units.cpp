@@ -96,12 +96,13 @@ TEST(ShardMerge, CollectsOneReplyPerShardAndNamesTheMissing) {
   EXPECT_TRUE(r.add(reply(0, 3, "[\"b\",\"a\"]")));
   EXPECT_FALSE(r.complete());
   EXPECT_EQ(r.missing(), std::vector<std::uint32_t>{1});
-  EXPECT_EQ(cli::missing_note(r, 2000), "shard 1/3 did not answer within 2000 ms: its vehicles are not included");
+  EXPECT_EQ(cli::missing_note(r, 2000, "vehicles"),
+            "shard 1/3 did not answer within 2000 ms: its vehicles are not included");
   EXPECT_EQ(cli::merged_vehicles(r), (std::vector<std::string>{"a", "b", "c"}));
   EXPECT_FALSE(r.failure());
   EXPECT_TRUE(r.add(reply(1, 3, "[\"a\",\"d\"]")));
   EXPECT_TRUE(r.complete());
-  EXPECT_EQ(cli::missing_note(r, 2000), "");
+  EXPECT_EQ(cli::missing_note(r, 2000, "vehicles"), "");
   EXPECT_EQ(cli::merged_vehicles(r), (std::vector<std::string>{"a", "b", "c", "d"}));
 }
 
@@ -130,8 +131,12 @@ TEST(ShardMerge, StatusOfSeveralShardsIsKeyedByShard) {
   r.add(reply(0, 3, "{\"requests\":1}"));
   EXPECT_EQ(cli::merged_status(r),
             "{\"shards\":{\"0/3\":{\"requests\":1},\"1/3\":{\"requests\":2,\"not_owned\":5}},\"missing\":[\"2/3\"]}");
-  EXPECT_EQ(cli::missing_note(r, 10),
-            "shard 2/3 did not answer within 10 ms: its vehicles are not included");
+  EXPECT_EQ(cli::missing_note(r, 10, "counters"),
+            "shard 2/3 did not answer within 10 ms: its counters are not included");
+  ShardReplies one_of_four;
+  one_of_four.add(reply(2, 4, "{}"));
+  EXPECT_EQ(cli::missing_note(one_of_four, 10, "counters"),
+            "shards 0/4, 1/4, 3/4 did not answer within 10 ms: their counters are not included");
 }
 
 TEST(ShardMerge, RefusalsAndBadPayloadsAreReported) {

@@ -73,7 +73,8 @@ int request_all(const Common& c, dynid::cli::RequestClient& client, const std::s
   std::cout << (kind == "status" ? dynid::cli::merged_status(replies)
                                  : dynid::cli::render_vehicles(dynid::cli::merged_vehicles(replies), c.json));
   if (kind == "status" || c.json) std::cout << "\n";
-  const std::string note = dynid::cli::missing_note(replies, timeout_of(c).count());
+  const std::string note =
+      dynid::cli::missing_note(replies, timeout_of(c).count(), kind == "status" ? "counters" : "vehicles");
   if (note.empty()) return 0;
   std::cerr << "dynid " << kind << ": " << note << "\n";
   return 6;

@@ -86,14 +86,14 @@ std::string merged_status(const ShardReplies& replies) {
   return out.dump();
 }
 
-std::string missing_note(const ShardReplies& replies, std::int64_t timeout_ms) {
+std::string missing_note(const ShardReplies& replies, std::int64_t timeout_ms, const std::string& what) {
   const auto missing = replies.missing();
   if (missing.empty()) return {};
   std::string names;
   for (const auto index : missing) names += (names.empty() ? "" : ", ") + shard_name(index, replies.count());
   return (missing.size() == 1 ? "shard " + names + " did not" : "shards " + names + " did not") +
          " answer within " + std::to_string(timeout_ms) + " ms: " +
-         (missing.size() == 1 ? "its" : "their") + " vehicles are not included";
+         (missing.size() == 1 ? "its " : "their ") + what + " are not included";
 }
 
 }  // namespace dynid::cli

@@ -57,8 +57,8 @@ std::vector<std::string> merged_vehicles(const ShardReplies& replies);
 /// The vehicle list as `dynid vehicles` prints it: one per line, or a JSON array.
 std::string render_vehicles(const std::vector<std::string>& vehicles, bool json);
 std::string merged_status(const ShardReplies& replies);
-/// E.g. "shard 1/2 did not answer within 10000 ms: its vehicles are not included". Empty
-/// when nothing is missing.
-std::string missing_note(const ShardReplies& replies, std::int64_t timeout_ms);
+/// E.g. "shard 1/2 did not answer within 10000 ms: its vehicles are not included" (`what`:
+/// "vehicles"). Empty when nothing is missing.
+std::string missing_note(const ShardReplies& replies, std::int64_t timeout_ms, const std::string& what);
 
 }  // namespace dynid::cli
