@@ -41,7 +41,9 @@ std::int64_t ns_since(Clock::time_point origin) {
 double own_cpu_seconds() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
-  const auto tv = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  const auto tv = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+  };
   return tv(usage.ru_utime) + tv(usage.ru_stime);
 }
 
@@ -54,7 +56,8 @@ std::vector<std::uint64_t> expected_rows(const SyntheticBodyRun& run, const Load
     processor.push(run.chunk("reference", o.run, k));
     const ls::EquationGroups* groups = processor.groups(0);
     std::uint64_t total = 0;
-    for (std::size_t g = 0; groups && g < groups->size(); ++g) total += groups->group(g).row_count();
+    for (std::size_t g = 0; groups && g < groups->size(); ++g)
+      total += groups->group(g).row_count();
     rows.push_back(total);
   }
   return rows;
@@ -72,8 +75,8 @@ struct Vehicle {
   dds::Writer<dynid_wire_RunAnnouncement> announcements;
   dds::Writer<dynid_wire_Chunk> chunk_writer;
   std::unique_ptr<std::atomic<std::int64_t>[]> written_at;  // ns since the origin
-  std::atomic<std::uint64_t> written{0};  // chunks 0..written-1 have been written
-  std::atomic<std::int64_t> acked{-2};    // highest contiguous; -2: announcement not accepted
+  std::atomic<std::uint64_t> written{0};                    // chunks 0..written-1 have been written
+  std::atomic<std::int64_t> acked{-2};  // highest contiguous; -2: announcement not accepted
   // Receiver thread only:
   std::uint64_t next_ack = 0, next_estimate = 0, last_rows = 0;
   bool has_estimate = false;
@@ -133,25 +136,31 @@ class Fleet {
 void Fleet::connect() {
   const auto deadline = Clock::now() + options_.patience;
   for (auto& v : vehicles_) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
     if (!v->chunk_writer.wait_for_readers(1, std::max(left, std::chrono::milliseconds(1))) ||
         !v->announcements.wait_for_readers(1, std::chrono::milliseconds(1000)))
       throw std::runtime_error("load: no server discovered for " + v->id + " within the patience");
   }
-  for (auto& v : vehicles_) v->announcements.write(dds::to_wire(run_.announcement(v->id, options_.run)).data);
+  for (auto& v : vehicles_)
+    v->announcements.write(dds::to_wire(run_.announcement(v->id, options_.run)).data);
   while (Clock::now() < deadline) {  // the server answers every accepted announcement with an ack
     take_acks();
-    if (std::all_of(vehicles_.begin(), vehicles_.end(), [](const auto& v) { return v->acked >= -1; })) return;
+    if (std::all_of(vehicles_.begin(), vehicles_.end(),
+                    [](const auto& v) { return v->acked >= -1; }))
+      return;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  throw std::runtime_error("load: the server did not accept every announcement within the patience");
+  throw std::runtime_error(
+      "load: the server did not accept every announcement within the patience");
 }
 
 void Fleet::send(Vehicle& v, std::uint64_t k) {
   const auto sample = dds::to_wire(run_.chunk(v.id, options_.run, k));
   v.written_at[k].store(ns_since(origin_), std::memory_order_relaxed);
   v.written.store(k + 1, std::memory_order_release);
-  while (!v.chunk_writer.write(sample.data)) {  // the server's reader is full: retry, as a spool does
+  while (
+      !v.chunk_writer.write(sample.data)) {  // the server's reader is full: retry, as a spool does
     retries_.fetch_add(1);
     if (stop_.load()) return;
   }
@@ -164,8 +173,9 @@ void Fleet::stream() {
     const double period = static_cast<double>(options_.chunk_rows) / options_.sample_rate_hz;
     const auto start = Clock::now();
     for (std::uint64_t j = 0; j < total; ++j) {
-      const auto due = start + std::chrono::duration_cast<Clock::duration>(
-                                   std::chrono::duration<double>(period * static_cast<double>(j) / static_cast<double>(n)));
+      const auto due =
+          start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                      period * static_cast<double>(j) / static_cast<double>(n)));
       std::this_thread::sleep_until(due);
       send(*vehicles_[j % n], j / n);
     }
@@ -177,7 +187,8 @@ void Fleet::stream() {
     for (auto& v : vehicles_) {
       const std::uint64_t k = v->written.load();
       if (k < options_.chunks_per_vehicle &&
-          static_cast<std::int64_t>(k) <= v->acked.load() + static_cast<std::int64_t>(options_.window)) {
+          static_cast<std::int64_t>(k) <=
+              v->acked.load() + static_cast<std::int64_t>(options_.window)) {
         send(*v, k);
         ++sent;
         any = true;
@@ -192,7 +203,8 @@ void Fleet::stream() {
 
 void Fleet::take_acks() {
   for (auto& s : acks_.take(256)) {
-    const auto it = index_.find(std::string(s.data.vehicle, strnlen(s.data.vehicle, sizeof s.data.vehicle)));
+    const auto it =
+        index_.find(std::string(s.data.vehicle, strnlen(s.data.vehicle, sizeof s.data.vehicle)));
     if (it == index_.end()) continue;
     Vehicle& v = *vehicles_[it->second];
     rejections_ += s.data.rejections._length;
@@ -200,7 +212,8 @@ void Fleet::take_acks() {
     if (mark > v.acked.load()) v.acked.store(mark);
     if (v.acked.load() < -1) v.acked.store(-1);
     const std::int64_t now = ns_since(origin_);
-    while (static_cast<std::int64_t>(v.next_ack) <= mark && v.next_ack < v.written.load(std::memory_order_acquire)) {
+    while (static_cast<std::int64_t>(v.next_ack) <= mark &&
+           v.next_ack < v.written.load(std::memory_order_acquire)) {
       ack_ms_.push_back(1e-6 * static_cast<double>(now - v.written_at[v.next_ack].load()));
       ++v.next_ack;
       last_ack_ns_ = now;
@@ -211,7 +224,8 @@ void Fleet::take_acks() {
 
 void Fleet::take_estimates() {
   for (auto& s : estimates_.take(256)) {
-    const auto it = index_.find(std::string(s.data.vehicle, strnlen(s.data.vehicle, sizeof s.data.vehicle)));
+    const auto it =
+        index_.find(std::string(s.data.vehicle, strnlen(s.data.vehicle, sizeof s.data.vehicle)));
     if (it == index_.end()) continue;
     Vehicle& v = *vehicles_[it->second];
     const std::int64_t now = ns_since(origin_);
@@ -239,8 +253,10 @@ bool Fleet::done() const {
 
 void Fleet::receive_loop() {
   dds::Entity waitset(dds::check(dds_create_waitset(participant_.handle()), "dds_create_waitset"));
-  dds::Entity on_ack(dds::check(dds_create_readcondition(acks_.handle(), DDS_ANY_STATE), "dds_create_readcondition"));
-  dds::Entity on_estimate(dds::check(dds_create_readcondition(estimates_.handle(), DDS_ANY_STATE), "dds_create_readcondition"));
+  dds::Entity on_ack(dds::check(dds_create_readcondition(acks_.handle(), DDS_ANY_STATE),
+                                "dds_create_readcondition"));
+  dds::Entity on_estimate(dds::check(dds_create_readcondition(estimates_.handle(), DDS_ANY_STATE),
+                                     "dds_create_readcondition"));
   dds::check(dds_waitset_attach(waitset.get(), on_ack.get(), 0), "dds_waitset_attach");
   dds::check(dds_waitset_attach(waitset.get(), on_estimate.get(), 1), "dds_waitset_attach");
   while (!stop_.load()) {
@@ -255,9 +271,11 @@ void Fleet::sample_rss() {
   auto next = Clock::now();
   while (!stop_.load()) {
     rss_t_.push_back(seconds_between(origin_, Clock::now()));
-    rss_mb_.push_back(static_cast<double>(read_process_stats(options_.server_pid).rss_bytes) / 1048576.0);
+    rss_mb_.push_back(static_cast<double>(read_process_stats(options_.server_pid).rss_bytes) /
+                      1048576.0);
     next += options_.rss_period;
-    while (!stop_.load() && Clock::now() < next) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    while (!stop_.load() && Clock::now() < next)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
 }
 
@@ -277,7 +295,8 @@ LoadResult Fleet::run() {
     throw;
   }
   const auto drain_end = Clock::now() + options_.drain;
-  while (Clock::now() < drain_end && !done()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  while (Clock::now() < drain_end && !done())
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   if (options_.server_pid > 0) server_end_ = read_process_stats(options_.server_pid);
   stop_.store(true);
   receiver.join();
@@ -325,7 +344,8 @@ LoadResult Fleet::summarize() {
   }
   const std::size_t skip = rss_t_.size() / 5;  // warm-up: runs and caches being created
   r.rss_samples = rss_t_.size();
-  r.rss_slope_kb_per_min = 1024.0 * 60.0 *
+  r.rss_slope_kb_per_min =
+      1024.0 * 60.0 *
       slope({rss_t_.begin() + static_cast<std::ptrdiff_t>(skip), rss_t_.end()},
             {rss_mb_.begin() + static_cast<std::ptrdiff_t>(skip), rss_mb_.end()});
   r.load_cpu_seconds = own_cpu_seconds() - load_cpu_start_;

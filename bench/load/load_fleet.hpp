@@ -44,13 +44,13 @@ struct LoadOptions {
   long chunk_rows = 100;
   double sample_rate_hz = 100.0;
   int odmf = 8;
-  bool paced = true;          ///< else as fast as the window allows
-  std::size_t window = 16;    ///< fast mode: unacknowledged chunks per vehicle
-  std::chrono::seconds patience{60};  ///< discovery and announcement acceptance
-  std::chrono::seconds drain{60};     ///< after the last write: wait for acks and estimates
-  pid_t server_pid = 0;                ///< 0: no /proc readings
+  bool paced = true;                        ///< else as fast as the window allows
+  std::size_t window = 16;                  ///< fast mode: unacknowledged chunks per vehicle
+  std::chrono::seconds patience{60};        ///< discovery and announcement acceptance
+  std::chrono::seconds drain{60};           ///< after the last write: wait for acks and estimates
+  pid_t server_pid = 0;                     ///< 0: no /proc readings
   std::chrono::milliseconds rss_period{0};  ///< 0: RSS only at start and end
-  std::string prefix = "load";        ///< vehicle ids "<prefix>-<k>"
+  std::string prefix = "load";              ///< vehicle ids "<prefix>-<k>"
   std::string run = "run-1";
 };
 
@@ -60,17 +60,17 @@ struct LoadResult {
   std::uint64_t lost = 0, missed = 0, rejections = 0, unmeasurable = 0;
   std::uint64_t vehicles_fully_acked = 0, vehicles_with_estimate = 0, final_rows_wrong = 0;
   std::uint64_t sample_rows_acked = 0, sample_rows_folded = 0, model_rows_folded = 0;
-  double stream_seconds = 0.0;     ///< first write -> last chunk acknowledged
-  double fold_seconds = 0.0;       ///< first write -> last measurable chunk seen in an estimate
+  double stream_seconds = 0.0;  ///< first write -> last chunk acknowledged
+  double fold_seconds = 0.0;    ///< first write -> last measurable chunk seen in an estimate
   double ack_p50_ms = 0.0, ack_p99_ms = 0.0;
   double estimate_p50_ms = 0.0, estimate_p99_ms = 0.0, estimate_max_ms = 0.0;
   std::uint64_t latency_samples = 0;
-  std::size_t chunk_bytes = 0;     ///< payload of one chunk sample (doubles + flags)
+  std::size_t chunk_bytes = 0;  ///< payload of one chunk sample (doubles + flags)
   double server_cpu_seconds = 0.0;
   double server_rss_start_mb = 0.0, server_rss_end_mb = 0.0, server_peak_rss_mb = 0.0;
   double rss_slope_kb_per_min = 0.0;  ///< over the samples after the first fifth
   std::uint64_t rss_samples = 0;
-  double load_cpu_seconds = 0.0;   ///< this process (it shares the machine with the server)
+  double load_cpu_seconds = 0.0;  ///< this process (it shares the machine with the server)
 
   std::string to_json() const;
 };

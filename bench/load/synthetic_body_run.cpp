@@ -1,7 +1,7 @@
 #include "synthetic_body_run.hpp"
 
-#include <array>
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -50,7 +50,8 @@ SyntheticBodyRun::SyntheticBodyRun(double sample_rate_hz, Eigen::Index chunk_row
   const auto theta = truth();
   const Eigen::Vector3d p_fl(kHubs[0][0], kHubs[0][1], kHubs[0][2]);
   period_ = Eigen::MatrixXd::Zero(kPeriodSamples, 30);
-  const double omega = 2.0 * std::numbers::pi * sample_rate_hz / static_cast<double>(kPeriodSamples);
+  const double omega =
+      2.0 * std::numbers::pi * sample_rate_hz / static_cast<double>(kPeriodSamples);
   for (Eigen::Index i = 0; i < kPeriodSamples; ++i) {
     const double t = static_cast<double>(i) / sample_rate_hz;
     std::array<double, 6> value{}, slope{};
@@ -74,13 +75,13 @@ SyntheticBodyRun::SyntheticBodyRun(double sample_rate_hz, Eigen::Index chunk_row
 }
 
 ingest::RunAnnouncement SyntheticBodyRun::announcement(const std::string& vehicle,
-                                                        const std::string& run) const {
+                                                       const std::string& run) const {
   ingest::RunAnnouncement a;
   a.vehicle = vehicle;
   a.run = run;
   a.sample_rate_hz = sample_rate_hz_;
-  a.channels = {{"ax", "m/s^2"},         {"ay", "m/s^2"},        {"az", "m/s^2"},
-                {"roll_rate", "rad/s"},  {"pitch_rate", "rad/s"}, {"yaw_rate", "rad/s"}};
+  a.channels = {{"ax", "m/s^2"},        {"ay", "m/s^2"},         {"az", "m/s^2"},
+                {"roll_rate", "rad/s"}, {"pitch_rate", "rad/s"}, {"yaw_rate", "rad/s"}};
   for (const char* corner : kCorners)
     for (std::size_t j = 0; j < kWrench.size(); ++j)
       a.channels.push_back({std::string("hub_") + kWrench[j] + "_" + corner, j < 3 ? "N" : "N m"});

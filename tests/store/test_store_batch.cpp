@@ -49,10 +49,10 @@ TEST(StoreBatch, ABatchThatThrowsLeavesNothing) {
   Store store(dir.file("batch.db"));
   store.add_run(announcement("car", "r1"));
   EXPECT_THROW(store.batch([](Store& s) {
-                 s.store_chunk(chunk("car", "r1", 0));
-                 s.store_chunk(chunk("car", "r1", 1));
-                 throw std::runtime_error("the caller gives up");
-               }),
+    s.store_chunk(chunk("car", "r1", 0));
+    s.store_chunk(chunk("car", "r1", 1));
+    throw std::runtime_error("the caller gives up");
+  }),
                std::runtime_error);
   EXPECT_FALSE(store.highest_contiguous({"car", "r1"}));
   EXPECT_EQ(store.store_chunk(chunk("car", "r1", 0)).status, ChunkStatus::stored);  // usable
