@@ -23,6 +23,8 @@ const std::map<std::string, KindSpec>& kinds() {
       {"close", {{"vehicle", "run"}, {"format"}, {}}},
       {"reprocess", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},
       {"base", {{"vehicle", "run", "model"}, {"format"}, {}}},
+      {"residual", {{"vehicle", "run", "model"}, {"effects", "candidates", "format"}, {}}},
+      {"add-effect", {{"vehicle", "run", "model", "effect"}, {"effects", "format"}, {}}},
       {"status", {{}, {"format"}, {}}},
       {"fleet", {{"model", "shared", "vehicles"}, {"format"}, {"shared"}}},
   };
@@ -73,8 +75,10 @@ ParsedRequest parse_request(const dds::Request& request) {
   for (const auto& name : spec->second.required)
     if (!parsed.arguments.count(name))
       throw InputError(where + ": '" + request.kind + "' needs argument '" + name + "'");
-  if (const auto format = parsed.optional("format"); format && *format != "text" && *format != "json")
-    throw InputError(where + ": format '" + *format + "' is neither text nor json");
+  // The residual reports are for people: text or an HTML page, not JSON.
+  const bool report = request.kind == "residual" || request.kind == "add-effect";
+  if (const auto format = parsed.optional("format"); format && *format != "text" && *format != (report ? "html" : "json"))
+    throw InputError(where + ": format '" + *format + "' is neither text nor " + (report ? "html" : "json"));
   return parsed;
 }
 

@@ -181,14 +181,30 @@ EstimateTables RunService::reprocess(const std::string& vehicle, const std::stri
     if (announced.model == model) spec.constants = announced.constants;  // the profile's
   announcement.models = {spec};
   ingest::RunProcessor processor(announcement, context_.options.store.limits);
+  replay_stored(key, state, [&](const ingest::Chunk& chunk) { processor.push(chunk); });
+  if (state.processor.finished()) processor.finish();
+  return tables_of(vehicle, "reprocess:" + run, processor.estimates());
+}
+
+void RunService::replay_stored(const store::RunKey& key, const RunState& state,
+                               const std::function<void(const ingest::Chunk&)>& sink) {
+  // A few chunks at a time: a long run is never held whole in the store's read buffers.
   for (std::uint64_t next = 0; state.contiguous >= 0 &&
                                next <= static_cast<std::uint64_t>(state.contiguous);) {
     const auto to = std::min<std::uint64_t>(next + 15, static_cast<std::uint64_t>(state.contiguous));
-    for (const auto& chunk : read_chunks(key, next, to)) processor.push(chunk);
+    for (const auto& chunk : read_chunks(key, next, to)) sink(chunk);
     next = to + 1;
   }
-  if (state.processor.finished()) processor.finish();
-  return tables_of(vehicle, "reprocess:" + run, processor.estimates());
+}
+
+ResidualReply RunService::residual(const std::string& vehicle, const std::string& run,
+                                   const ResidualRequest& request) {
+  flush_pending();  // the chunks received before this request count
+  const store::RunKey key{vehicle, run};
+  const RunState& state = load(key);
+  std::vector<ingest::Chunk> chunks;
+  replay_stored(key, state, [&](const ingest::Chunk& chunk) { chunks.push_back(chunk); });
+  return residual_reply(state.processor.announcement(), chunks, request);
 }
 
 std::string RunService::base_report(const std::string& vehicle, const std::string& run,

@@ -149,6 +149,12 @@ dds::Reply Server::Impl::execute(const ParsedRequest& r, RunService& service) {
                      r.json());
   } else if (r.kind == "base") {
     payload = service.base_report(vehicle, r.required("run"), r.required("model"), r.json());
+  } else if (r.kind == "residual" || r.kind == "add-effect") {
+    ResidualRequest request{r.required("model"), std::nullopt, split_list(r.optional("candidates").value_or("")),
+                            r.kind == "add-effect" ? r.required("effect") : "", r.optional("format").value_or("text")};
+    if (const auto effects = r.optional("effects")) request.effects = split_list(*effects);
+    ResidualReply reply = service.residual(vehicle, r.required("run"), request);
+    return {{}, 0, dds::ReplyStatus::kOk, {}, reply.payload_format, std::move(reply.payload)};
   }
   return {{}, 0, dds::ReplyStatus::kOk, {}, format, payload};
 }

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 
 #include "dynid/cli/request_client.hpp"
@@ -88,6 +89,24 @@ int request(const Common& c, const std::string& kind, std::vector<RequestArgumen
   return print(kind, client.call(kind, arguments, timeout_of(c)));
 }
 
+// A residual report: printed, or with --html written to that file (the page is self-contained).
+int report_request(const Common& c, const std::string& kind, const std::vector<RequestArgument>& arguments,
+                   const std::string& html_file) {
+  if (html_file.empty()) return request(c, kind, arguments);
+  dynid::dds::Participant participant({c.domain, config_uri(c.config)});
+  dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
+  const dynid::dds::Reply reply = client.call(kind, arguments, timeout_of(c));
+  if (reply.status != dynid::dds::ReplyStatus::kOk) return print(kind, reply);
+  std::ofstream out(html_file, std::ios::binary);
+  out << reply.payload;
+  if (!out.flush()) {
+    std::cerr << "dynid " << kind << ": cannot write " << html_file << "\n";
+    return 2;
+  }
+  std::cout << "report written to " << html_file << " (" << reply.payload.size() << " bytes)\n";
+  return 0;
+}
+
 int watch(const Common& c, const std::string& vehicle, double seconds) {
   dynid::dds::Participant participant({c.domain, config_uri(c.config)});
   dynid::dds::Reader<dynid_wire_Estimate> reader(participant, {dynid::dds::vehicle_partition(vehicle)});
@@ -148,6 +167,21 @@ int main(int argc, char** argv) {
   reprocess_cmd->add_option("--run", run)->required();
   reprocess_cmd->add_option("--model", model)->required();
   reprocess_cmd->add_option("--effects", effects, "comma-separated candidate effects");
+  std::string candidates, effect, html;
+  auto* residual_cmd = app.add_subcommand("residual", "which effect does a run's model lack? (docs/RESIDUAL.md)");
+  residual_cmd->add_option("--vehicle", vehicle)->required();
+  residual_cmd->add_option("--run", run)->required();
+  residual_cmd->add_option("--model", model)->required();
+  residual_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's)");
+  residual_cmd->add_option("--candidates", candidates, "test only these candidates (comma-separated)");
+  residual_cmd->add_option("--html", html, "write the HTML report with plots to this file");
+  auto* add_effect_cmd = app.add_subcommand("add-effect", "a run's model with one more effect: before and after");
+  add_effect_cmd->add_option("--vehicle", vehicle)->required();
+  add_effect_cmd->add_option("--run", run)->required();
+  add_effect_cmd->add_option("--model", model)->required();
+  add_effect_cmd->add_option("--effect", effect, "the effect to add, e.g. road_grade")->required();
+  add_effect_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's)");
+  add_effect_cmd->add_option("--html", html, "write the HTML report with plots to this file");
   auto* base_cmd = app.add_subcommand("base", "base-parameter report of a run's model");
   base_cmd->add_option("--vehicle", vehicle)->required();
   base_cmd->add_option("--run", run)->required();
@@ -184,6 +218,11 @@ int main(int argc, char** argv) {
     }
     if (*reprocess_cmd)
       return request(c, "reprocess", args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects}}));
+    if (*residual_cmd || *add_effect_cmd) {
+      auto a = args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects},
+                     {"candidates", candidates}, {"effect", effect}, {"format", html.empty() ? "" : "html"}});
+      return report_request(c, *residual_cmd ? "residual" : "add-effect", a, html);
+    }
     if (*base_cmd) return request(c, "base", args({{"vehicle", vehicle}, {"run", run}, {"model", model}}));
     if (*close_cmd) return request(c, "close", args({{"vehicle", vehicle}, {"run", run}}));
     if (*status_cmd) return request(c, "status", {});

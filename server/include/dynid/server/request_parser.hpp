@@ -10,10 +10,15 @@
 //   close       vehicle*, run*, format                          final tables; run closed
 //   reprocess   vehicle*, run*, model*, effects, format         replay into a fresh processor
 //   base        vehicle*, run*, model*, format                  base-parameter report
+//   residual    vehicle*, run*, model*, effects, candidates,    ranked candidate effects
+//               format                                          (residual_requests.hpp)
+//   add-effect  vehicle*, run*, model*, effect*, effects,       before/after report
+//               format
 //   status      format                                          the server's counters
 //   fleet       model*, shared*+, vehicles*, format             fleet estimate (ls/fleet.hpp)
 // vehicles is a comma-separated list; a fleet spans the vehicles of one shard.
-// format is "text" (default) or "json"; effects is a comma-separated list.
+// format is "text" (default) or "json" ("text" or "html" for residual and add-effect); effects
+// and candidates are comma-separated lists.
 //
 // parse_request() throws InputError naming the request ("request alice@host/42#7") and the
 // problem: an unknown kind, an unknown, missing, repeated or empty argument, a bad format.

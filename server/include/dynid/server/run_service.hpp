@@ -32,6 +32,7 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -46,6 +47,7 @@
 #include "dynid/server/counters.hpp"
 #include "dynid/server/estimate_tables.hpp"
 #include "dynid/server/options.hpp"
+#include "dynid/server/residual_requests.hpp"
 #include "dynid/server/shared_store.hpp"
 #include "dynid/server/vehicle_outputs.hpp"
 
@@ -107,6 +109,9 @@ class RunService {
   std::string base_report(const std::string& vehicle, const std::string& run,
                           const std::string& model, bool json);
   std::string list_runs(const std::string& vehicle, bool json);
+  /// The residual loop on a stored run (residual_requests.hpp): the run replayed from the store.
+  ResidualReply residual(const std::string& vehicle, const std::string& run,
+                         const ResidualRequest& request);
 
  private:
   struct UnsavedCheckpoint {
@@ -148,6 +153,9 @@ class RunService {
                                          const std::vector<const ingest::Chunk*>& in_hand);
   std::vector<ingest::Chunk> read_chunks(const store::RunKey& key, std::uint64_t from,
                                          std::uint64_t to);
+  /// Every stored chunk of the run up to the highest contiguous one, in order, to `sink`.
+  void replay_stored(const store::RunKey& key, const RunState& run,
+                     const std::function<void(const ingest::Chunk&)>& sink);
   void take_checkpoint(const store::RunKey& key, RunState& run);
   void save_folds(const std::vector<store::RunKey>& keys);
   void save_fold(store::Store& s, const store::RunKey& key, RunState& run);
