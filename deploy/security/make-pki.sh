@@ -65,6 +65,7 @@ done
 # ---- validation: everything before the first write ------------------------------------------
 
 [[ -n "$out" ]] || { usage >&2; die "--out is required"; }
+[[ ! -e "$out" || -d "$out" ]] || die "--out '$out' exists and is not a folder"
 (( ${#servers[@]} + ${#cars[@]} + ${#engineers[@]} > 0 )) ||
   die "no subject given: name at least one --server, --car or --engineer"
 [[ "$days" =~ ^[1-9][0-9]{0,5}$ ]] || die "--days '$days': a whole number of days, 1 to 999999"
@@ -106,10 +107,12 @@ fi
 
 # ---- generation, in a staging folder --------------------------------------------------------
 
+[[ -d "$out" ]] || created_out=1
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 stage="$(mktemp -d "$out/.staging-XXXXXX")"
-trap 'rm -rf "$stage"' EXIT
+# On any exit: the staging folder goes; an --out made by this run goes too if it stayed empty.
+trap 'rm -rf "$stage"; if [[ -n "${created_out:-}" ]]; then rmdir "$out" 2>/dev/null || true; fi' EXIT
 umask 077  # private keys; the rest is made readable below
 
 now_s="$(date -u +%s)"

@@ -58,14 +58,14 @@ int reap(pid_t pid, std::chrono::milliseconds timeout) {
   return -1;
 }
 
+}  // namespace
+
 std::string read_text(const std::filesystem::path& file) {
   std::ifstream in(file);
   std::stringstream text;
   text << in.rdbuf();
   return text.str();
 }
-
-}  // namespace
 
 TempDir::TempDir() {
   std::string pattern = (std::filesystem::temp_directory_path() / "dynid-security-XXXXXX").string();

@@ -9,6 +9,7 @@
 #include <sys/types.h>
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -43,6 +44,9 @@ struct Outcome {
 
 /// Runs argv (argv[0] a path, no shell) to its end or the deadline (then SIGKILL).
 Outcome run(const std::vector<std::string>& argv, std::chrono::milliseconds timeout);
+
+/// The whole content of a file ("" if it cannot be read).
+std::string read_text(const std::filesystem::path& file);
 
 /// deploy/cyclonedds/loopback.xml (no security) plus this process's discovery tag.
 std::string plain_config();

@@ -16,12 +16,11 @@
 //   3  refused: Cyclone would not create the reader or writer (DDS_RETCODE_NOT_ALLOWED_BY_SECURITY
 //      or another creation failure, named in the output)
 //   1  bad arguments
+#include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <iostream>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "dynid/car/uplink.hpp"

@@ -4,9 +4,6 @@
 // message naming them and change nothing.
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
-
 #include "security_fixture.hpp"
 
 namespace dynid::security_test {
@@ -18,13 +15,6 @@ Outcome make_pki(const std::vector<std::string>& arguments) {
   std::vector<std::string> argv{kTool};
   argv.insert(argv.end(), arguments.begin(), arguments.end());
   return run(argv, 60s);
-}
-
-std::string text(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 Outcome openssl(const std::vector<std::string>& arguments) {
@@ -46,26 +36,26 @@ TEST(MakePki, IssuesVerifiableIdentitiesAndGrantsAndEnrolsWithTheSameCa) {
     const auto signed_by_ca = openssl({"smime", "-verify", "-in", (out / subject / "permissions.p7s").string(),
                                        "-CAfile", ca, "-out", "/dev/null"});
     EXPECT_EQ(signed_by_ca.exit_code, 0) << subject << ": " << signed_by_ca.output;
-    EXPECT_NE(text(out / subject / "cyclonedds.xml").find("<NetworkInterface address=\"127.0.0.1\"/>"),
+    EXPECT_NE(read_text(out / subject / "cyclonedds.xml").find("<NetworkInterface address=\"127.0.0.1\"/>"),
               std::string::npos) << subject << ": the loopback configuration is kept";
   }
-  const std::string car = text(out / "car-A" / "permissions.xml");
+  const std::string car = read_text(out / "car-A" / "permissions.xml");
   EXPECT_NE(car.find("<subject_name>CN=A,OU=car,O=dynid</subject_name>"), std::string::npos) << car;
   EXPECT_NE(car.find("<partition>vehicle/A</partition>"), std::string::npos) << car;
   EXPECT_EQ(car.find("vehicle/*"), std::string::npos) << "a car is granted its own partition only\n" << car;
   EXPECT_EQ(car.find("dynid/Estimate"), std::string::npos) << car;
-  EXPECT_EQ(text(out / "engineer-alice" / "permissions.xml").find("dynid/Chunk<"), std::string::npos);
+  EXPECT_EQ(read_text(out / "engineer-alice" / "permissions.xml").find("dynid/Chunk<"), std::string::npos);
 
-  const std::string ca_before = text(ca), car_before = text(out / "car-A" / "cert.pem");
+  const std::string ca_before = read_text(ca), car_before = read_text(out / "car-A" / "cert.pem");
   const auto enrolled = make_pki({"--out", out.string(), "--days", "1", "--car", "C"});
   ASSERT_EQ(enrolled.exit_code, 0) << enrolled.output;
-  EXPECT_EQ(text(ca), ca_before) << "enrolling keeps the CA";
+  EXPECT_EQ(read_text(ca), ca_before) << "enrolling keeps the CA";
   EXPECT_EQ(openssl({"verify", "-CAfile", ca, (out / "car-C" / "cert.pem").string()}).exit_code, 0);
 
   const auto again = make_pki({"--out", out.string(), "--car", "A"});
   EXPECT_EQ(again.exit_code, 1);
   EXPECT_NE(again.output.find("car 'A' is already enrolled"), std::string::npos) << again.output;
-  EXPECT_EQ(text(out / "car-A" / "cert.pem"), car_before) << "a refused enrolment changes nothing";
+  EXPECT_EQ(read_text(out / "car-A" / "cert.pem"), car_before) << "a refused enrolment changes nothing";
 }
 
 TEST(MakePki, RefusesBadArgumentsNamingThemAndWritesNothing) {
@@ -90,6 +80,11 @@ TEST(MakePki, RefusesBadArgumentsNamingThemAndWritesNothing) {
     EXPECT_NE(result.output.find(message), std::string::npos) << "expected '" << message << "' in\n" << result.output;
     EXPECT_FALSE(std::filesystem::exists(out)) << message << ": nothing may be written";
   }
+  const auto file = dir.path() / "a-file";
+  std::filesystem::copy_file(std::string(DYNID_SOURCE_DIR) + "/deploy/cyclonedds/loopback.xml", file);
+  const auto not_a_folder = make_pki({"--out", file.string(), "--car", "A"});
+  EXPECT_EQ(not_a_folder.exit_code, 1);
+  EXPECT_NE(not_a_folder.output.find("exists and is not a folder"), std::string::npos) << not_a_folder.output;
 }
 
 }  // namespace

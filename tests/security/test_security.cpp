@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <functional>
 #include <future>
 #include <optional>
 
@@ -43,7 +44,7 @@ class Security : public ::testing::Test {
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "server status " << status << "\n" << server_log();
     return read_store(store);
   }
-  std::string server_log() const { return run({"/bin/cat", log.string()}, 5s).output; }
+  std::string server_log() const { return read_text(log); }
 
   /// A legitimate car streams a run: acknowledged in full (the positive control).
   void stream(const std::string& car, const std::string& vehicle, const std::string& run) {
@@ -75,7 +76,7 @@ std::vector<Outcome> together(const std::vector<std::function<Outcome()>>& calls
 // DDS and through the dynid CLI.
 TEST_F(Security, CarWithItsIdentityStreamsAndTheEngineerReadsItsEstimates) {
   start_secure();
-  stream("car-A", "A", "run-1");
+  ASSERT_NO_FATAL_FAILURE(stream("car-A", "A", "run-1"));
   const auto estimates = peer(pki.config("engineer-alice"), kPositivePatience, {"estimates", "A"});
   EXPECT_EQ(estimates.exit_code, 0) << estimates.output;
   const auto vehicles = cli(pki.config("engineer-alice"), {"vehicles"});
@@ -92,7 +93,7 @@ TEST_F(Security, CarWithItsIdentityStreamsAndTheEngineerReadsItsEstimates) {
 TEST_F(Security, ParticipantsWithoutAValidIdentityNeitherReadEstimatesNorInjectChunks) {
   const Pki rogue(dir.path() / "rogue", {"--car", "A", "--engineer", "alice"});  // same names
   start_secure();
-  stream("car-A", "A", "run-1");
+  ASSERT_NO_FATAL_FAILURE(stream("car-A", "A", "run-1"));
   const auto outcomes = together({
       [] { return peer(plain_config(), kNegativePatience, {"estimates", "A"}); },
       [] { return peer(plain_config(), kNegativePatience, {"car", "A", "run-plain"}); },
@@ -111,7 +112,7 @@ TEST_F(Security, ParticipantsWithoutAValidIdentityNeitherReadEstimatesNorInjectC
 // (sender_partition.hpp); its own run works.
 TEST_F(Security, CarCannotWriteOrReadAnotherCarsData) {
   start_secure();
-  stream("car-B", "B", "run-b");
+  ASSERT_NO_FATAL_FAILURE(stream("car-B", "B", "run-b"));
   const auto outcomes = together({
       [&] { return peer(pki.config("car-A"), kNegativePatience, {"car", "B", "run-forged"}); },
       [&] { return peer(pki.config("car-A"), kNegativePatience, {"estimates", "B"}); },
@@ -129,7 +130,7 @@ TEST_F(Security, CarCannotWriteOrReadAnotherCarsData) {
 // cannot send requests.
 TEST_F(Security, EngineerReadsAndRequestsButCannotWriteChunks) {
   start_secure();
-  stream("car-A", "A", "run-1");
+  ASSERT_NO_FATAL_FAILURE(stream("car-A", "A", "run-1"));
   const auto outcomes = together({
       [&] { return peer(pki.config("engineer-alice"), kNegativePatience, {"car", "A", "run-e"}); },
       [&] { return peer(pki.config("engineer-alice"), kPositivePatience, {"estimates", "A"}); },
