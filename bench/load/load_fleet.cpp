@@ -1,6 +1,7 @@
 #include "load_fleet.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <sys/resource.h>
 
 #include <atomic>
@@ -344,6 +345,7 @@ LoadResult Fleet::summarize() {
   }
   const std::size_t skip = rss_t_.size() / 5;  // warm-up: runs and caches being created
   r.rss_samples = rss_t_.size();
+  r.rss_series_mb = rss_mb_;
   r.rss_slope_kb_per_min =
       1024.0 * 60.0 *
       slope({rss_t_.begin() + static_cast<std::ptrdiff_t>(skip), rss_t_.end()},
@@ -363,13 +365,13 @@ std::string LoadResult::to_json() const {
       R"("ack_p50_ms":{:.3f},"ack_p99_ms":{:.3f},"estimate_p50_ms":{:.3f},"estimate_p99_ms":{:.3f},)"
       R"("estimate_max_ms":{:.3f},"latency_samples":{},"chunk_bytes":{},"server_cpu_seconds":{:.3f},)"
       R"("server_rss_start_mb":{:.2f},"server_rss_end_mb":{:.2f},"server_peak_rss_mb":{:.2f},)"
-      R"("rss_slope_kb_per_min":{:.2f},"rss_samples":{},"load_cpu_seconds":{:.3f}}})",
+      R"("rss_slope_kb_per_min":{:.2f},"rss_samples":{},"load_cpu_seconds":{:.3f},"rss_series_mb":[{:.2f}]}})",
       vehicles, chunks_written, chunks_acked, write_retries, lost, missed, rejections, unmeasurable,
       vehicles_fully_acked, vehicles_with_estimate, final_rows_wrong, sample_rows_acked,
       sample_rows_folded, model_rows_folded, stream_seconds, fold_seconds, ack_p50_ms, ack_p99_ms,
       estimate_p50_ms, estimate_p99_ms, estimate_max_ms, latency_samples, chunk_bytes,
       server_cpu_seconds, server_rss_start_mb, server_rss_end_mb, server_peak_rss_mb,
-      rss_slope_kb_per_min, rss_samples, load_cpu_seconds);
+      rss_slope_kb_per_min, rss_samples, load_cpu_seconds, fmt::join(rss_series_mb, ","));
 }
 
 LoadResult run_load(const LoadOptions& options) {

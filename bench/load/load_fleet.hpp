@@ -70,6 +70,7 @@ struct LoadResult {
   double server_rss_start_mb = 0.0, server_rss_end_mb = 0.0, server_peak_rss_mb = 0.0;
   double rss_slope_kb_per_min = 0.0;  ///< over the samples after the first fifth
   std::uint64_t rss_samples = 0;
+  std::vector<double> rss_series_mb;  ///< every sample, in order (the soak's curve)
   double load_cpu_seconds = 0.0;  ///< this process (it shares the machine with the server)
 
   std::string to_json() const;

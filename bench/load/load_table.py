@@ -46,6 +46,9 @@ def soak(rows):
               f"{r['server_rss_end_mb']:.1f} MB (peak {r['server_peak_rss_mb']:.1f}), slope after the "
               f"first fifth {r['rss_slope_kb_per_min']:.1f} KB/min over {r['rss_samples']} samples, "
               f"chunk->estimate p50 {r['estimate_p50_ms']:.1f} ms p99 {r['estimate_p99_ms']:.1f} ms")
+        series = r.get("rss_series_mb", [])
+        step = max(1, len(series) // 10)
+        print("RSS (MB) every", step, "samples:", " ".join(f"{v:.1f}" for v in series[::step]))
 
 
 def main():
