@@ -78,6 +78,21 @@ TEST(BaseParameters, ClassifiesZeroAndDependentColumns) {
   EXPECT_EQ(e.structure.relation(2, names), "e + f");
 }
 
+// Full rank: the regrouping matrix has no column (and no storage), every parameter is
+// identified. Taking rows of that empty matrix was pointer arithmetic on null (clang's UBSan,
+// tests/fuzz/fuzz_chunk); this case runs that path in every sanitizer build.
+TEST(BaseParameters, FullRankHasNoRegrouping) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> gauss;
+  Eigen::MatrixXd W(50, 3);
+  for (Eigen::Index i = 0; i < W.size(); ++i) W.data()[i] = gauss(rng);
+  const ls::Estimate e = fold_in_packets(W, W * Eigen::Vector3d(1.0, -2.0, 0.5));
+  EXPECT_EQ(e.structure.rank(), 3);
+  EXPECT_EQ(e.structure.regrouping.rows(), 3);
+  EXPECT_EQ(e.structure.regrouping.cols(), 0);
+  EXPECT_EQ(e.structure.status, std::vector<ParameterStatus>(3, ParameterStatus::kIdentified));
+}
+
 TEST(BaseParameters, NoiseFreeEstimateEqualsRegroupedTruth) {
   const Deficient d = deficient_problem(400);
   const ls::Estimate e = fold_in_packets(d.W, d.W * d.x_true);

@@ -144,7 +144,9 @@ BaseParameterAnalysis analyse_base_parameters(const Eigen::Ref<const Eigen::Matr
     out.status[static_cast<std::size_t>(j)] = ParameterStatus::kEliminated;
   for (Eigen::Index j : out.dependent)
     out.status[static_cast<std::size_t>(j)] = ParameterStatus::kDependent;
-  for (std::size_t k = 0; k < out.base.size(); ++k)
+  // With no dependent column the regrouping matrix has no column and no storage: taking a row
+  // of it is pointer arithmetic on null (UBSan, found by tests/fuzz/fuzz_chunk).
+  for (std::size_t k = 0; k < out.base.size() && !out.dependent.empty(); ++k)
     if ((out.regrouping.row(static_cast<Eigen::Index>(k)).array() != 0.0).any())
       out.status[static_cast<std::size_t>(out.base[k])] = ParameterStatus::kRegrouped;
   return out;
