@@ -126,18 +126,36 @@ std::string resealed(std::string body) {
   return body;
 }
 
-TEST(ChunkEncoding, RefusesAbsurdSizesWithoutAllocating) {
+// A 4-row chunk's encoding without its checksum, with its row and column counts set (they sit
+// after magic (8), version (2), two strings and two u64).
+std::string with_counts(std::uint64_t rows, std::uint64_t cols) {
   test::TestRun run = test::make_run(100);
   std::string bytes = encode_chunk(test::cut(run, 0, 0, 4));
   bytes.resize(bytes.size() - 4);
-  // rows sit after magic (8), version (2), two strings and two u64.
   const std::size_t rows_at =
       8 + 2 + 4 + run.announcement.vehicle.size() + 4 + run.announcement.run.size() + 16;
+  std::memcpy(bytes.data() + rows_at, &rows, sizeof(rows));
+  std::memcpy(bytes.data() + rows_at + sizeof(rows), &cols, sizeof(cols));
+  return bytes;
+}
+
+TEST(ChunkEncoding, RefusesAbsurdSizesWithoutAllocating) {
   const std::uint64_t huge = std::uint64_t{1} << 60;
-  std::memcpy(bytes.data() + rows_at, &huge, sizeof(huge));
-  expect_input_error([&] { (void)decode_chunk(resealed(bytes)); }, {"samples claimed"});
+  expect_input_error([&] { (void)decode_chunk(resealed(with_counts(huge, 6))); },
+                     {"samples claimed"});
   expect_input_error([&] { (void)decode_chunk(resealed("DYNIDCHK\x07")); }, {"version"});
   expect_input_error([&] { (void)decode_chunk(resealed("NOTACHNK\x01")); }, {"bad magic"});
+}
+
+// Zero columns (or zero rows) carry no sample bytes, so the other count was not bounded: 2^60
+// rows of nothing hung the decoder's loops (found by tests/fuzz/fuzz_chunk, whose corpus keeps
+// the input as timeout-zero-columns.chunk).
+TEST(ChunkEncoding, RefusesAbsurdCountsBesideAZeroDimension) {
+  const std::uint64_t huge = std::uint64_t{1} << 60;
+  expect_input_error([&] { (void)decode_chunk(resealed(with_counts(huge, 0))); },
+                     {"samples claimed"});
+  expect_input_error([&] { (void)decode_chunk(resealed(with_counts(0, huge))); },
+                     {"samples claimed"});
 }
 
 TEST(RunAnnouncement, ValidatesFieldsByName) {

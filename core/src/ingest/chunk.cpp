@@ -1,5 +1,6 @@
 #include "dynid/ingest/chunk.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -113,7 +114,14 @@ Chunk decode_chunk(std::string_view bytes) {
   c.first_sample_index = r.get<std::uint64_t>("first sample index");
   const auto rows = r.get<std::uint64_t>("rows");
   const auto cols = r.get<std::uint64_t>("columns");
-  if (cols != 0 && rows > r.remaining() / sizeof(double) / cols)
+  // With zero rows or zero columns there are no sample bytes to bound the other dimension by;
+  // no valid chunk has either, and a corrupted count must not make the loops below or
+  // encode_chunk's reservation work on an absurd size (a hang found by tests/fuzz/fuzz_chunk),
+  // so it is bounded by the bytes left all the same.
+  const std::uint64_t left = r.remaining();
+  const bool fits = rows == 0 || cols == 0 ? std::max(rows, cols) <= left
+                                           : rows <= left / sizeof(double) / cols;
+  if (!fits)
     r.fail("truncated or corrupted: " + std::to_string(rows) + " x " + std::to_string(cols) +
            " samples claimed, " + std::to_string(r.remaining()) + " bytes left");
   c.samples.resize(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols));
