@@ -82,6 +82,12 @@ TEST(Candump, WriterRejectsFramesItCannotWrite) {
   f = parse("(1.0) can0 123#00");
   f.id = 0x800;
   EXPECT_THROW(format_candump_line(f), InputError);
+  // The reader takes any finite time; one whose microseconds overflow a 64-bit count was written
+  // as "(-9223372036854.-775808)", a line nobody reads back (tests/fuzz/fuzz_candump).
+  f = parse("(170000000046408.587693) can1 214#930C2C0900FC11FF");
+  EXPECT_THROW(format_candump_line(f), InputError);
+  f.timestamp = 9.1e12;
+  EXPECT_EQ(format_candump_line(parse(format_candump_line(f))), format_candump_line(f));
 }
 
 // canplayer needs a CAN interface to send on; log2long (same package, same line parser as

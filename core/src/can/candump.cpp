@@ -114,10 +114,19 @@ std::string parse_frame(std::string_view word, Frame& f) {
   return parse_data(rest, Frame::kMaxClassicData, f);
 }
 
+// Largest timestamp whose microsecond count fits a long long (2^63 us, about 292,000 years).
+constexpr double kMaxWritableSeconds = 9.2e12;
+
 void check_writable(const Frame& f) {
   if (!std::isfinite(f.timestamp) || f.timestamp < 0.0)
     throw InputError("candump writer: timestamp " + std::to_string(f.timestamp) +
                      " is not a finite non-negative number");
+  // The line holds whole microseconds as a 64-bit count; past that llround's result is garbage
+  // and the line written unreadable (a log line "(170000000046408.5) ..." read back and
+  // rewritten as "(-9223372036854.-775808)": found by tests/fuzz/fuzz_candump).
+  if (f.timestamp >= kMaxWritableSeconds)
+    throw InputError("candump writer: timestamp " + std::to_string(f.timestamp) +
+                     " s is too large for the log's microsecond count");
   if (f.interface_name().empty()) throw InputError("candump writer: frame has no interface name");
   if (f.id > (f.extended ? Frame::kMaxExtendedId : Frame::kMaxStandardId))
     throw InputError("candump writer: id " + std::to_string(f.id) + " too large for " +

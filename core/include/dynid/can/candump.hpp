@@ -29,7 +29,8 @@ namespace dynid::can {
 std::string parse_candump_line(std::string_view line, Frame& frame);
 
 // One line in candump -l format, without the newline. Throws InputError for a frame that
-// cannot be written (negative or non-finite timestamp, empty interface name, id too large
+// cannot be written (negative, non-finite or too large timestamp (>= 9.2e12 s: its microsecond
+// count would overflow), empty interface name, id too large
 // for its kind, classic length > 8, FD length not a valid FD length).
 std::string format_candump_line(const Frame& frame);
 
