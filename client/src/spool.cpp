@@ -31,6 +31,16 @@ CREATE TABLE IF NOT EXISTS announcements (
   PRIMARY KEY (vehicle, run));
 )sql";
 
+// A failure of SQLite on `db`: SpoolWriteError when the filesystem refused a write (full, or
+// an I/O error: worth retrying later), else std::runtime_error; both name the file.
+[[noreturn]] void throw_sqlite(sqlite3* db, int rc, const std::string& message) {
+  const int primary = rc & 0xff;
+  const std::string where = std::string("spool ") + sqlite3_db_filename(db, "main") + ": ";
+  if (primary == SQLITE_FULL) throw SpoolWriteError(where + "disk full (" + message + ")");
+  if (primary == SQLITE_IOERR) throw SpoolWriteError(where + "write failed (" + message + ")");
+  throw std::runtime_error(where + message);
+}
+
 // A prepared statement that finalizes itself; errors carry SQLite's message.
 class Statement {
  public:
@@ -58,7 +68,7 @@ class Statement {
   bool step() {
     const int rc = sqlite3_step(stmt_);
     if (rc == SQLITE_ROW) return true;
-    if (rc != SQLITE_DONE) throw std::runtime_error(std::string("spool: ") + sqlite3_errmsg(db_));
+    if (rc != SQLITE_DONE) throw_sqlite(db_, rc, sqlite3_errmsg(db_));
     return false;
   }
   std::uint64_t u64(int col) const { return static_cast<std::uint64_t>(sqlite3_column_int64(stmt_, col)); }
@@ -130,15 +140,11 @@ Spool::~Spool() { sqlite3_close(db_); }
 
 void Spool::exec(const char* sql) const {
   char* err = nullptr;
-  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
-    const std::string msg = err ? err : "unknown error";
+  if (const int rc = sqlite3_exec(db_, sql, nullptr, nullptr, &err); rc != SQLITE_OK) {
+    const std::string msg = err ? err : sqlite3_errstr(rc);
     sqlite3_free(err);
-    fail(msg);
+    throw_sqlite(db_, rc, msg);
   }
-}
-
-void Spool::fail(const std::string& what) const {
-  throw std::runtime_error("spool " + file_.string() + ": " + what);
 }
 
 std::string Spool::full_message(std::uint64_t incoming) const {

@@ -14,6 +14,11 @@ std::string name_of(const std::string& vehicle, const std::string& run, std::uin
   return vehicle + "/" + run + "#" + std::to_string(sequence);
 }
 
+// What a held chunk costs in memory, near enough for the bound.
+std::uint64_t held_size(const ingest::Chunk& chunk) {
+  return static_cast<std::uint64_t>(chunk.samples.size()) * sizeof(double) + chunk.valid.size() + 256;
+}
+
 }  // namespace
 
 Delivery::Delivery(Spool& spool, Uplink& uplink, DeliveryOptions options, DeliveryLog logger)
@@ -37,13 +42,70 @@ void Delivery::announce(const ingest::RunAnnouncement& announcement) {
 }
 
 void Delivery::submit(const ingest::Chunk& chunk) {
-  spool_.store(chunk);  // durable before it is sent; throws (SpoolFull...) before queueing
-  ++stats_.submitted;
-  queue_.push_back({chunk.vehicle, chunk.run, chunk.sequence, false});
+  if (!held_.empty()) {
+    hold(chunk, {});  // behind the held ones: the spool stays a prefix of the run
+  } else {
+    try {
+      spool_.store(chunk);  // durable before it is sent; throws (SpoolFull...) before queueing
+      ++stats_.submitted;
+      queue_.push_back({chunk.vehicle, chunk.run, chunk.sequence, false});
+    } catch (const SpoolWriteError& e) {
+      hold(chunk, e.what());
+    }
+  }
   service(std::chrono::milliseconds(0));
 }
 
+void Delivery::hold(const ingest::Chunk& chunk, const std::string& why) {
+  const std::uint64_t bytes = held_size(chunk);
+  if (held_bytes_ + bytes > options_.max_held_bytes)
+    throw SpoolFull("spool " + spool_.file().string() + " cannot store chunks and " + std::to_string(held_.size()) +
+                    " (" + std::to_string(held_bytes_) + " bytes) already wait in memory: " +
+                    name_of(chunk.vehicle, chunk.run, chunk.sequence) + " does not fit");
+  if (held_.empty())
+    log(LogLevel::error, why + ": holding " + name_of(chunk.vehicle, chunk.run, chunk.sequence) +
+                             " and what follows in memory until the spool can store them (nothing is sent "
+                             "before it is spooled; retrying)");
+  held_.push_back(chunk);
+  held_bytes_ += bytes;
+  ++stats_.held;
+}
+
+void Delivery::spool_held() {
+  std::size_t stored = 0;
+  while (!held_.empty()) {
+    const ingest::Chunk& chunk = held_.front();
+    try {
+      spool_.store(chunk);
+    } catch (const SpoolWriteError&) {
+      return;  // still no room: reported when the outage began
+    } catch (const SpoolFull&) {
+      return;  // the spool's own bound: acknowledgements make room
+    }
+    ++stats_.submitted;
+    ++stored;
+    queue_.push_back({chunk.vehicle, chunk.run, chunk.sequence, false});
+    held_bytes_ -= held_size(chunk);
+    held_.pop_front();
+  }
+  if (stored > 0)
+    log(LogLevel::info, "spool " + spool_.file().string() + " stores again: " + std::to_string(stored) +
+                            " chunks held in memory are spooled");
+}
+
+void Delivery::record_acknowledgements() {
+  for (auto it = unrecorded_.begin(); it != unrecorded_.end(); it = unrecorded_.erase(it)) {
+    try {
+      spool_.acknowledge(it->first.first, it->first.second, it->second);
+    } catch (const SpoolWriteError&) {
+      return;  // reported when it first failed
+    }
+  }
+}
+
 void Delivery::service(std::chrono::milliseconds wait) {
+  record_acknowledgements();  // first: deleting acknowledged chunks makes room
+  spool_held();
   bool rejected = false;
   for (const auto& receipt : uplink_.receipts(wait)) rejected = on_receipt(receipt) || rejected;
   if (rejected && sent_ > 0) restart_round("the server rejected a chunk in flight");
@@ -68,7 +130,14 @@ bool Delivery::drain(std::chrono::milliseconds timeout) {
 }
 
 std::string Delivery::holdup() const {
-  if (queue_.empty()) return {};
+  if (!held_.empty())
+    return std::to_string(held_.size()) + " chunks wait in memory, lost at exit: the spool " + spool_.file().string() +
+           " could not store them";
+  if (queue_.empty())
+    return unrecorded_.empty() ? std::string()
+                               : "the spool " + spool_.file().string() +
+                                     " could not record the server's acknowledgements (its chunks are resent "
+                                     "on the next start and acknowledged again)";
   const Entry& oldest = queue_.front();
   std::string why = std::to_string(queue_.size()) + " chunks unacknowledged, oldest " +
                     name_of(oldest.vehicle, oldest.run, oldest.sequence);
@@ -104,7 +173,17 @@ void Delivery::acknowledge(const std::string& vehicle, const std::string& run, s
   const auto acked_in_flight = static_cast<std::size_t>(std::count_if(queue_.begin(), in_flight_end, covered));
   const auto before = queue_.size();
   // The spool first: if the process dies now, the worst case is resending acknowledged chunks.
-  if (std::any_of(queue_.begin(), queue_.end(), covered)) spool_.acknowledge(vehicle, run, through);
+  if (std::any_of(queue_.begin(), queue_.end(), covered)) {
+    try {
+      spool_.acknowledge(vehicle, run, through);
+    } catch (const SpoolWriteError& e) {  // the server holds them: only the spool's record waits
+      if (unrecorded_.empty())
+        log(LogLevel::warning, std::string(e.what()) + ": acknowledgement of " + name_of(vehicle, run, through) +
+                                   " not recorded in the spool yet; retrying");
+      auto& mark = unrecorded_[{vehicle, run}];
+      mark = std::max(mark, through);
+    }
+  }
   std::erase_if(queue_, covered);
   const std::size_t removed = before - queue_.size();
   if (removed == 0) return;

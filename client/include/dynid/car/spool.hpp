@@ -24,7 +24,10 @@
 // - pending() lists the unacknowledged chunks in the order they were stored, which is sequence
 //   order within a run, also after reopening the spool (a client restart).
 // - A corrupted chunk read back (CRC) throws InputError naming the chunk; the spool's own I/O
-//   failures throw std::runtime_error with SQLite's message and the file.
+//   failures throw std::runtime_error with SQLite's message and the file. A write that the
+//   filesystem refuses (SQLITE_FULL: "disk full", or an I/O error) throws SpoolWriteError:
+//   nothing was stored, acknowledged or deleted, and the same call can be retried once there
+//   is room (Delivery holds the chunks meanwhile).
 // - Announcements: store_announcement() keeps a run's announcement durably (the same bytes
 //   again are a no-op; another announcement for the same vehicle and run throws InputError), so
 //   a restarted client can announce its pending runs again before resending their chunks.
@@ -47,6 +50,13 @@ struct sqlite3;
 namespace dynid::car {
 
 class SpoolFull : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The spool's file could not be written (disk full, I/O error); nothing changed. The message
+/// names the file and says "disk full" when that is the reason.
+class SpoolWriteError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
@@ -90,7 +100,6 @@ class Spool {
 
  private:
   void exec(const char* sql) const;
-  [[noreturn]] void fail(const std::string& what) const;
   std::string full_message(std::uint64_t incoming) const;
 
   std::filesystem::path file_;

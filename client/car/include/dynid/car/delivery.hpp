@@ -11,6 +11,14 @@
 // - announce() stores the run's announcement in the spool, then publishes it.
 // - submit() stores the chunk (durable when it returns; SpoolFull and InputError propagate and
 //   nothing is queued), then sends it if the window allows. It never drops a chunk.
+// - A spool whose filesystem refuses the write (SpoolWriteError: disk full, I/O error): the
+//   chunk, and every later one, waits in memory in order, and service() retries storing them
+//   oldest first; nothing is sent before it is spooled, so the spool stays a prefix of the
+//   run. The outage is logged as an error once (naming the spool and the reason) and its end
+//   as info. Held bytes are bounded by `max_held_bytes`: beyond, submit() throws SpoolFull (the
+//   caller stops reading, as for a full spool). An acknowledgement the spool cannot record is
+//   retried the same way (the chunks stay in the spool meanwhile; the server holds them).
+//   What is held in memory is lost if the process dies before it is spooled.
 // - At most `window` chunks are in flight (sent, not yet acknowledged): the server reads chunks
 //   keep-all with bounded depth, and a car must not overrun it. The rest wait in the spool and
 //   go out, in order, as acknowledgements free the window.
@@ -48,6 +56,7 @@ using DeliveryLog = std::function<void(LogLevel, const std::string&)>;
 struct DeliveryOptions {
   std::chrono::milliseconds ack_timeout{5000};
   std::size_t window = 32;  ///< below the chunk QoS's 64 unread samples per run
+  std::uint64_t max_held_bytes = 64ULL << 20;  ///< chunks held while the spool cannot store
 };
 
 struct DeliveryStats {
@@ -58,6 +67,7 @@ struct DeliveryStats {
   std::uint64_t resend_rounds = 0;
   std::uint64_t blocked = 0;       ///< sends refused because the server's queue stayed full
   std::uint64_t rejections = 0;    ///< distinct rejections reported by the server
+  std::uint64_t held = 0;          ///< chunks held in memory while the spool could not store
 };
 
 class Delivery {
@@ -69,12 +79,12 @@ class Delivery {
   void service(std::chrono::milliseconds wait);
   bool drain(std::chrono::milliseconds timeout);
 
-  bool drained() const { return queue_.empty(); }
+  bool drained() const { return queue_.empty() && held_.empty() && unrecorded_.empty(); }
   bool server_knows(const std::string& vehicle, const std::string& run) const {
     return known_runs_.count({vehicle, run}) > 0;
   }
-  /// Chunks in the spool (this process's and earlier ones').
-  std::size_t pending() const { return queue_.size(); }
+  /// Chunks in the spool (this process's and earlier ones') and held for it.
+  std::size_t pending() const { return queue_.size() + held_.size(); }
   std::size_t in_flight() const { return sent_; }
   const DeliveryStats& stats() const { return stats_; }
   /// Why the oldest pending chunk is not acknowledged, as far as the car knows (a rejection's
@@ -94,6 +104,11 @@ class Delivery {
   bool on_receipt(const dds::ChunkReceipt& receipt);
   void acknowledge(const std::string& vehicle, const std::string& run, std::uint64_t through);
   void restart_round(const std::string& why);
+  /// Stores the held chunks, oldest first, until the spool refuses again.
+  void spool_held();
+  void hold(const ingest::Chunk& chunk, const std::string& why);
+  /// Records acknowledgements the spool could not record earlier.
+  void record_acknowledgements();
   void pump();
   void log(LogLevel level, const std::string& message) const;
 
@@ -102,6 +117,9 @@ class Delivery {
   DeliveryOptions options_;
   DeliveryLog log_;
   std::deque<Entry> queue_;  // the spool's chunks, storage order
+  std::deque<ingest::Chunk> held_;  // not yet spooled (the spool could not write), in order
+  std::uint64_t held_bytes_ = 0;
+  std::map<std::pair<std::string, std::string>, std::uint64_t> unrecorded_;  // acks to record
   std::size_t sent_ = 0;     // queue_[0, sent_) are in flight in the current round
   Clock::time_point last_progress_;
   std::uint32_t readers_seen_ = 0;
