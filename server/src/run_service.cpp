@@ -69,7 +69,12 @@ RunService::RunState& RunService::load_from_store(const store::RunKey& key) {
   state->contiguous = contiguous;
   RunState& run = *runs_.emplace(key, std::move(state)).first->second;
   const std::uint64_t from = run.processor.next_sequence();
-  fold_ready(key, run, {});
+  try {
+    fold_ready(key, run, {});
+  } catch (...) {  // e.g. a damaged chunk: a run folded part way must never be served
+    runs_.erase(key);
+    throw;
+  }
   save_folds({key});
   if (closed && !run.processor.finished()) run.processor.finish();
   spdlog::info("run {}: resumed at #{} ({} stored contiguously{})", label(key), from,

@@ -24,7 +24,10 @@
 // Restart (resume): the latest checkpoint is restored (a damaged one is reported and the run
 // rebuilt from #0), the stored chunks after it are replayed, and the ledger's folded mark
 // moves forward with them, so nothing is folded twice. Open runs are resumed at start; closed
-// runs are loaded (and finished) the first time a request needs them.
+// runs are loaded (and finished) the first time a request needs them. A stored chunk that
+// cannot be read back (damaged: CorruptionError naming the file and the chunk) fails the load,
+// and the run is not kept part way: every request on it fails the same way until the store is
+// restored, rather than serving a partial run as if it were complete.
 //
 // Should a stored chunk be refused by the processor (a model rejects its rows), the run stops
 // folding ("halted", with the reason, logged and in the ack); its chunks stay in the store for
