@@ -355,9 +355,13 @@ void RunService::publish_tables(const std::string& vehicle, EstimateTables table
   }
 }
 
-void RunService::publish_due(std::chrono::steady_clock::time_point now) {
+void RunService::settle() {
   flush_pending();
-  if (!unsaved_.empty()) save_folds(std::exchange(unsaved_, {}));  // idle: nothing to ride on
+  if (!unsaved_.empty()) save_folds(std::exchange(unsaved_, {}));  // no next batch to ride on
+}
+
+void RunService::publish_due(std::chrono::steady_clock::time_point now) {
+  settle();
   for (auto& [key, run] : runs_) {
     if (!run->dirty || now - run->last_published < context_.options.publish_interval) continue;
     try {

@@ -90,7 +90,7 @@ std::string RunService::latest_run(const std::string& vehicle) {
 EstimateTables RunService::estimate(const std::string& vehicle,
                                     const std::optional<std::string>& run,
                                     const std::optional<std::string>& model) {
-  flush_pending();  // the chunks received before this request count
+  settle();  // the chunks received before this request count, the ledger up to date
   const store::RunKey key{vehicle, run ? *run : latest_run(vehicle)};
   const RunState& state = load(key);
   auto tables = tables_of(vehicle, key.run, state.processor.estimates(), model);
@@ -102,7 +102,7 @@ EstimateTables RunService::estimate(const std::string& vehicle,
 
 EstimateTables RunService::pooled(const std::string& vehicle, const std::vector<std::string>& runs,
                                   const std::optional<std::string>& model) {
-  flush_pending();  // the chunks received before this request count
+  settle();  // the chunks received before this request count, the ledger up to date
   if (runs.empty()) throw InputError("pooled: name at least one run");
   if (std::set<std::string>(runs.begin(), runs.end()).size() != runs.size())
     throw InputError("pooled: a run is named twice (" + join(runs, ", ") + ")");
@@ -132,7 +132,7 @@ EstimateTables RunService::pooled(const std::string& vehicle, const std::vector<
 }
 
 FleetSource RunService::fleet_member(const std::string& vehicle, const std::string& model) {
-  flush_pending();  // the chunks received before this request count
+  settle();  // the chunks received before this request count, the ledger up to date
   latest_run(vehicle);  // NotFound for an unknown vehicle or one without runs
   const auto stored = context_.store.with([&](store::Store& s) { return s.list_runs(vehicle); });
   FleetSource out;
@@ -157,7 +157,7 @@ FleetSource RunService::fleet_member(const std::string& vehicle, const std::stri
 }
 
 EstimateTables RunService::close(const std::string& vehicle, const std::string& run) {
-  flush_pending();  // the chunks received before this request count
+  settle();  // the chunks received before this request count, the ledger up to date
   const store::RunKey key{vehicle, run};
   RunState& state = load(key);
   if (!state.processor.finished()) state.processor.finish();  // folds the held-back samples
@@ -172,7 +172,7 @@ EstimateTables RunService::close(const std::string& vehicle, const std::string& 
 EstimateTables RunService::reprocess(const std::string& vehicle, const std::string& run,
                                      const std::string& model,
                                      const std::vector<std::string>& effects) {
-  flush_pending();  // the chunks received before this request count
+  settle();  // the chunks received before this request count, the ledger up to date
   const store::RunKey key{vehicle, run};
   const RunState& state = load(key);
   ingest::RunAnnouncement announcement = state.processor.announcement();
@@ -199,7 +199,7 @@ void RunService::replay_stored(const store::RunKey& key, const RunState& state,
 
 ResidualReply RunService::residual(const std::string& vehicle, const std::string& run,
                                    const ResidualRequest& request) {
-  flush_pending();  // the chunks received before this request count
+  settle();  // the chunks received before this request count, the ledger up to date
   const store::RunKey key{vehicle, run};
   const RunState& state = load(key);
   std::vector<ingest::Chunk> chunks;
@@ -209,7 +209,7 @@ ResidualReply RunService::residual(const std::string& vehicle, const std::string
 
 std::string RunService::base_report(const std::string& vehicle, const std::string& run,
                                     const std::string& model, bool json) {
-  flush_pending();  // the chunks received before this request count
+  settle();  // the chunks received before this request count, the ledger up to date
   const RunState& state = load({vehicle, run});
   const auto estimates = state.processor.estimates();
   const std::size_t m = model_index(estimates, model);
@@ -240,7 +240,7 @@ std::string RunService::base_report(const std::string& vehicle, const std::strin
 }
 
 std::string RunService::list_runs(const std::string& vehicle, bool json) {
-  flush_pending();  // the chunks received before this request count
+  settle();  // the chunks received before this request count, the ledger up to date
   latest_run(vehicle);  // NotFound for an unknown vehicle or one without runs
   const auto runs = context_.store.with([&](store::Store& s) { return s.list_runs(vehicle); });
   std::string text = fmt::format("{:<24} {:<7} {:>10} {:>10} {:>8}\n", "run", "state", "stored", "folded", "chunks");

@@ -96,6 +96,9 @@ class RunService {
   void publish_due(std::chrono::steady_clock::time_point now);
   /// Stores, acknowledges and folds the chunks receive_chunk queued (see above).
   void flush_pending();
+  /// flush_pending(), then saves the folded marks and checkpoints still unsaved: the store's
+  /// ledger is then up to date (before a request reads it, and on every tick).
+  void settle();
 
   // Run-level requests. InputError/NotFound name what is wrong.
   EstimateTables estimate(const std::string& vehicle, const std::optional<std::string>& run,
