@@ -171,7 +171,7 @@ void RunService::flush_pending() {
   std::map<store::RunKey, std::vector<const ingest::Chunk*>> stored;
   for (std::size_t i = 0; i < batch.size(); ++i) {
     const store::RunKey& key = batch[i].key;
-    RunState& run = *find(key);  // loaded by receive_chunk; runs are never unloaded
+    RunState& run = *find(key);  // loaded by receive_chunk; only a failed load unloads a run
     if (const auto* refused = std::get_if<std::string>(&results[i])) {
       reject(key, &run, batch[i].chunk.sequence, *refused);
       continue;
@@ -292,7 +292,8 @@ void RunService::save_folds(const std::vector<store::RunKey>& keys) {
   try {
     context_.store.with([&](store::Store& s) {
       s.batch([&](store::Store& b) {
-        for (const auto& key : keys) save_fold(b, key, *find(key));
+        for (const auto& key : keys)
+          if (RunState* run = find(key)) save_fold(b, key, *run);
       });
     });
   } catch (const std::exception& e) {
@@ -303,7 +304,8 @@ void RunService::save_folds(const std::vector<store::RunKey>& keys) {
 // Inside a batch: the marks and checkpoints flush_pending left for later. Should the batch
 // not commit, they are lost, which only lengthens a replay after a restart.
 void RunService::save_unsaved(store::Store& s) {
-  for (const auto& key : std::exchange(unsaved_, {})) save_fold(s, key, *find(key));
+  for (const auto& key : std::exchange(unsaved_, {}))
+    if (RunState* run = find(key)) save_fold(s, key, *run);
 }
 
 void RunService::save_fold(store::Store& s, const store::RunKey& key, RunState& run) {
