@@ -92,6 +92,8 @@ struct RunProcessor::Impl {
   std::vector<ModelRun> models;
   model::RowReach reach;
   std::optional<detail::SegmentStream> segment;
+  // The rollback copy of `segment` a push works on (kept to reuse its buffers between chunks).
+  std::optional<detail::SegmentStream> scratch;
   RunCounters counters;
   std::uint64_t next_sequence = 0;
   std::uint64_t next_index = 0;
@@ -105,6 +107,7 @@ struct RunProcessor::Impl {
                std::vector<FoldJob>& jobs) const;
   void end_segment(detail::SegmentStream& seg, RunCounters& c, std::vector<FoldJob>& jobs) const;
   void fold(const std::vector<FoldJob>& jobs);
+  detail::SegmentStream& working_copy();
 };
 
 RunProcessor::Impl::Impl(RunAnnouncement a, ChunkLimits l)
@@ -249,6 +252,14 @@ void RunProcessor::Impl::fold(const std::vector<FoldJob>& jobs) {
     }
 }
 
+detail::SegmentStream& RunProcessor::Impl::working_copy() {
+  if (scratch)
+    *scratch = *segment;
+  else
+    scratch.emplace(*segment);
+  return *scratch;
+}
+
 RunProcessor::RunProcessor(RunAnnouncement announcement, ChunkLimits limits)
     : impl_(std::make_unique<Impl>(std::move(announcement), limits)) {}
 RunProcessor::RunProcessor(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -269,7 +280,7 @@ void RunProcessor::push(const Chunk& chunk) {
                      ", expected " + std::to_string(s.next_index) +
                      " (gaps are sent as invalid rows, not skipped)");
   // Work on copies of the stream state: a model rejecting the data leaves everything unchanged.
-  detail::SegmentStream seg = *s.segment;
+  detail::SegmentStream& seg = s.working_copy();
   RunCounters c = s.counters;
   std::vector<FoldJob> jobs;
   const Eigen::Index m = chunk.samples.rows();
@@ -288,7 +299,7 @@ void RunProcessor::push(const Chunk& chunk) {
     k = e;
   }
   s.fold(jobs);
-  *s.segment = std::move(seg);
+  std::swap(s.segment, s.scratch);
   s.counters = c;
   ++s.counters.chunks;
   s.counters.samples += static_cast<std::uint64_t>(m);
@@ -301,12 +312,12 @@ void RunProcessor::finish() {
   if (s.finished)
     throw InputError("run " + s.announcement.vehicle + "/" + s.announcement.run +
                      ": already finished");
-  detail::SegmentStream seg = *s.segment;
+  detail::SegmentStream& seg = s.working_copy();
   RunCounters c = s.counters;
   std::vector<FoldJob> jobs;
   s.end_segment(seg, c, jobs);
   s.fold(jobs);
-  *s.segment = std::move(seg);
+  std::swap(s.segment, s.scratch);
   s.counters = c;
   s.finished = true;
 }

@@ -16,6 +16,12 @@ Eigen::MatrixXd gather(const Eigen::Ref<const Eigen::MatrixXd>& x,
   return out;
 }
 
+// dst's first `rows` rows = src's, keeping dst's buffer when it is large enough.
+void copy_rows(Eigen::MatrixXd& dst, const Eigen::MatrixXd& src, Eigen::Index rows) {
+  if (dst.cols() != src.cols() || dst.rows() < rows) dst.resize(src.rows(), src.cols());
+  dst.topRows(rows) = src.topRows(rows);
+}
+
 void put_index(ByteWriter& w, Eigen::Index v) {
   w.put<std::int64_t>(v);
 }
@@ -36,6 +42,29 @@ SegmentStream::SegmentStream(const signal::Sos& sos, Layout layout, double sampl
     derivative_.emplace(static_cast<Eigen::Index>(layout_.derived_from.size()), sample_period);
   fifo_.resize(2 * (filter_.delay() + 1), static_cast<Eigen::Index>(layout_.unfiltered.size()));
   window_.resize(usual_window(), layout_.width());
+}
+
+SegmentStream::SegmentStream(const SegmentStream& other)
+    : layout_(other.layout_), reach_(other.reach_), filter_(other.filter_) {
+  *this = other;
+}
+
+SegmentStream& SegmentStream::operator=(const SegmentStream& other) {
+  if (this == &other) return *this;
+  layout_ = other.layout_;
+  reach_ = other.reach_;
+  filter_ = other.filter_;
+  derivative_ = other.derivative_;
+  active_ = other.active_;
+  start_ = other.start_;
+  copy_rows(fifo_, other.fifo_, other.fifo_rows_);
+  fifo_rows_ = other.fifo_rows_;
+  copy_rows(window_, other.window_, other.window_rows_);
+  window_first_ = other.window_first_;
+  window_rows_ = other.window_rows_;
+  derived_end_ = other.derived_end_;
+  built_ = other.built_;
+  return *this;
 }
 
 void SegmentStream::start(std::uint64_t start) {

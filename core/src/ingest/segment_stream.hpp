@@ -44,6 +44,13 @@ class SegmentStream {
  public:
   SegmentStream(const signal::Sos& sos, Layout layout, double sample_period, double tolerance,
                 model::RowReach reach);
+  /// Copies carry the live rows only; assigned into a stream of the same run it reuses the
+  /// buffers (the processor keeps a rollback copy per chunk: this makes it cheap).
+  SegmentStream(const SegmentStream& other);
+  SegmentStream& operator=(const SegmentStream& other);
+  SegmentStream(SegmentStream&&) noexcept = default;
+  SegmentStream& operator=(SegmentStream&&) noexcept = default;
+  ~SegmentStream() = default;
 
   /// Starts a new segment at grid index `start` (forgets the previous one).
   void start(std::uint64_t start);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "cascade.hpp"
@@ -87,6 +88,49 @@ StreamingZeroPhaseFilter::StreamingZeroPhaseFilter(Sos sos, Eigen::Index channel
   reset();
 }
 
+StreamingZeroPhaseFilter::StreamingZeroPhaseFilter(const StreamingZeroPhaseFilter& other)
+    : sos_(other.sos_),
+      unit_state_(other.unit_state_),
+      channels_(other.channels_),
+      padlen_(other.padlen_),
+      overlap_(other.overlap_),
+      block_(other.block_),
+      n_in_(other.n_in_),
+      n_out_(other.n_out_),
+      finished_(other.finished_),
+      head_(other.head_),
+      raw_tail_(other.raw_tail_),
+      forward_state_(other.forward_state_) {
+  copy_pending(other);
+}
+
+StreamingZeroPhaseFilter& StreamingZeroPhaseFilter::operator=(const StreamingZeroPhaseFilter& other) {
+  if (this == &other) return *this;
+  sos_ = other.sos_;
+  unit_state_ = other.unit_state_;
+  channels_ = other.channels_;
+  padlen_ = other.padlen_;
+  overlap_ = other.overlap_;
+  block_ = other.block_;
+  n_in_ = other.n_in_;
+  n_out_ = other.n_out_;
+  finished_ = other.finished_;
+  head_ = other.head_;
+  raw_tail_ = other.raw_tail_;
+  forward_state_ = other.forward_state_;
+  copy_pending(other);
+  return *this;
+}
+
+void StreamingZeroPhaseFilter::copy_pending(const StreamingZeroPhaseFilter& other) {
+  const Eigen::Index rows = other.pending_rows_;
+  if (pending_.cols() != channels_ || pending_.rows() < rows)
+    pending_.resize(std::max(rows, other.pending_.rows()), channels_);
+  pending_.topRows(rows) = other.pending_.middleRows(other.pending_first_, rows);
+  pending_first_ = 0;
+  pending_rows_ = rows;
+}
+
 void StreamingZeroPhaseFilter::reset() {
   n_in_ = 0;
   n_out_ = 0;
@@ -95,6 +139,7 @@ void StreamingZeroPhaseFilter::reset() {
   raw_tail_.resize(0, channels_);
   forward_state_.setZero(unit_state_.size(), channels_);  // defined before start: state() copies it
   pending_.resize(0, channels_);
+  pending_first_ = 0;
   pending_rows_ = 0;
 }
 
@@ -135,10 +180,11 @@ Eigen::MatrixXd StreamingZeroPhaseFilter::finish() {
     detail::run_forward(sos_, forward_state_.col(c).data(), pad.data(), padlen_);
     z = unit_state_ * pad(padlen_ - 1);
     detail::run_backward(sos_, z.data(), pad.data(), padlen_);
-    out.col(c) = pending_.col(c).head(pending_rows_);
+    out.col(c) = pending_.col(c).segment(pending_first_, pending_rows_);
     detail::run_backward(sos_, z.data(), out.col(c).data(), pending_rows_);
   }
   n_out_ += pending_rows_;
+  pending_first_ = 0;
   pending_rows_ = 0;
   pending_.resize(0, channels_);
   finished_ = true;
@@ -169,14 +215,31 @@ void StreamingZeroPhaseFilter::start_forward() {
   forward_into_pending(head);
 }
 
+void StreamingZeroPhaseFilter::make_room(Eigen::Index m) {
+  // Room for m more rows after the held ones: move the held rows to the top (one block move per
+  // channel, seldom: only when the rows released since the last move leave too little room),
+  // and grow only when they alone do not fit.
+  if (pending_first_ + pending_rows_ + m <= pending_.rows()) return;
+  if (pending_first_ > 0) {
+    for (Eigen::Index c = 0; c < channels_; ++c) {
+      double* col = pending_.col(c).data();
+      std::memmove(col, col + pending_first_, sizeof(double) * static_cast<std::size_t>(pending_rows_));
+    }
+    pending_first_ = 0;
+  }
+  const Eigen::Index usual = 4 * (overlap_ + block_);
+  if (pending_.rows() < pending_rows_ + m)
+    pending_.conservativeResize(std::max({2 * pending_.rows(), pending_rows_ + m, usual}),
+                                Eigen::NoChange);
+}
+
 void StreamingZeroPhaseFilter::forward_into_pending(const Eigen::MatrixXd& x) {
   const Eigen::Index m = x.rows();
-  if (pending_.rows() < pending_rows_ + m)
-    pending_.conservativeResize(std::max(2 * pending_.rows(), pending_rows_ + m), Eigen::NoChange);
-  pending_.middleRows(pending_rows_, m) = x;
+  make_room(m);
+  const Eigen::Index at = pending_first_ + pending_rows_;
+  pending_.middleRows(at, m) = x;
   for (Eigen::Index c = 0; c < channels_; ++c)
-    detail::run_forward(sos_, forward_state_.col(c).data(), pending_.col(c).data() + pending_rows_,
-                        m);
+    detail::run_forward(sos_, forward_state_.col(c).data(), pending_.col(c).data() + at, m);
   pending_rows_ += m;
 }
 
@@ -190,24 +253,28 @@ Eigen::MatrixXd StreamingZeroPhaseFilter::release(Eigen::Index blocks) {
   Eigen::VectorXd z(unit_state_.size());
   for (Eigen::Index c = 0; c < channels_; ++c) {
     for (Eigen::Index b = 0; b < blocks; ++b) {
-      sweep = pending_.col(c).segment(b * block_, span);
+      sweep = pending_.col(c).segment(pending_first_ + b * block_, span);
       z = unit_state_ * sweep(span - 1);
       detail::run_backward(sos_, z.data(), sweep.data(), span);
       out.col(c).segment(b * block_, block_) = sweep.head(block_);
     }
   }
-  const Eigen::Index left = pending_rows_ - count;
-  pending_.topRows(left) = pending_.middleRows(count, left).eval();
-  pending_rows_ = left;
+  pending_first_ += count;
+  pending_rows_ -= count;
   n_out_ += count;
-  const Eigen::Index usual = 2 * (overlap_ + block_);
-  if (pending_.rows() > 2 * usual) pending_.conservativeResize(usual, Eigen::NoChange);
+  // A long chunk grew the buffer: give the memory back so idle runs stay small.
+  const Eigen::Index usual = 4 * (overlap_ + block_);
+  if (pending_.rows() > 2 * usual && pending_rows_ <= usual) {
+    pending_.topRows(pending_rows_) = pending_.middleRows(pending_first_, pending_rows_).eval();
+    pending_first_ = 0;
+    pending_.conservativeResize(usual, Eigen::NoChange);
+  }
   return out;
 }
 
 StreamingZeroPhaseFilter::State StreamingZeroPhaseFilter::state() const {
   return {n_in_, n_out_, finished_, head_, raw_tail_, forward_state_,
-          pending_.topRows(pending_rows_)};
+          pending_.middleRows(pending_first_, pending_rows_)};
 }
 
 void StreamingZeroPhaseFilter::check_state(const State& s) const {
@@ -240,6 +307,7 @@ void StreamingZeroPhaseFilter::restore(const State& s) {
   raw_tail_ = s.raw_tail;
   forward_state_ = s.forward_state;
   pending_ = s.pending;
+  pending_first_ = 0;
   pending_rows_ = s.pending.rows();
 }
 

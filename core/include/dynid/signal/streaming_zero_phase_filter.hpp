@@ -36,6 +36,13 @@ class StreamingZeroPhaseFilter {
   // tolerance: bound on the error relative to max|x|, in [1e-13, 1e-3]; channels >= 1.
   // Throws InputError otherwise.
   StreamingZeroPhaseFilter(Sos sos, Eigen::Index channels, double tolerance = 1e-10);
+  // Copies carry the held samples only, not the spare buffer room; a copy assigned into a filter
+  // of the same shape reuses its buffers (what a caller keeping a rollback copy per push wants).
+  StreamingZeroPhaseFilter(const StreamingZeroPhaseFilter& other);
+  StreamingZeroPhaseFilter& operator=(const StreamingZeroPhaseFilter& other);
+  StreamingZeroPhaseFilter(StreamingZeroPhaseFilter&&) noexcept = default;
+  StreamingZeroPhaseFilter& operator=(StreamingZeroPhaseFilter&&) noexcept = default;
+  ~StreamingZeroPhaseFilter() = default;
 
   // chunk: rows = samples, one column per channel (any number of rows, including 0). Returns the
   // output samples that became final, in order, continuing the previous returns.
@@ -85,6 +92,8 @@ class StreamingZeroPhaseFilter {
   Eigen::MatrixXd release(Eigen::Index blocks);
   void check_state(const State& state) const;
   void keep_raw_tail(const Eigen::MatrixXd& chunk);
+  void copy_pending(const StreamingZeroPhaseFilter& other);
+  void make_room(Eigen::Index rows);
 
   Sos sos_;
   Eigen::VectorXd unit_state_;  // steady state of the cascade for a unit constant input
@@ -99,7 +108,10 @@ class StreamingZeroPhaseFilter {
   Eigen::MatrixXd head_;           // raw samples until padlen + 1 are in (the forward pass waits)
   Eigen::MatrixXd raw_tail_;       // last padlen + 1 raw samples, for the odd extension at the end
   Eigen::MatrixXd forward_state_;  // 2 per section x channels
-  Eigen::MatrixXd pending_;        // forward outputs of samples n_out_.. (first pending_rows_ rows)
+  // Forward outputs of samples n_out_.., rows [pending_first_, pending_first_ + pending_rows_):
+  // releasing advances pending_first_, and the rows are moved up only when the room runs out.
+  Eigen::MatrixXd pending_;
+  Eigen::Index pending_first_ = 0;
   Eigen::Index pending_rows_ = 0;
 };
 
