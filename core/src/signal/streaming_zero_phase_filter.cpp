@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "cascade.hpp"
 #include "checks.hpp"
@@ -53,6 +54,50 @@ void impulse_magnitudes(const Sos& sos, Visit visit) {
     if (level <= 1e-30 * peak) return;
   }
 }
+
+// Channels run through the cascade kLanes at a time (detail::step_lanes), in a buffer of
+// interleaved samples reused between calls of the same shape.
+constexpr int kLanes = 4;
+
+struct Lanes {
+  std::vector<double> data;  // sample k of lane l at data[k * kLanes + l]
+  std::vector<double> z;     // delay i of lane l at z[i * kLanes + l]
+
+  // Rows [first, first + n) of columns [c, c + kLanes) of m.
+  void gather(const Eigen::MatrixXd& m, Eigen::Index first, Eigen::Index n, Eigen::Index c) {
+    data.resize(static_cast<std::size_t>(n * kLanes));
+    for (int l = 0; l < kLanes; ++l) {
+      const double* src = m.col(c + l).data() + first;
+      for (Eigen::Index k = 0; k < n; ++k) data[static_cast<std::size_t>(k * kLanes + l)] = src[k];
+    }
+  }
+  // Rows [from, from + n) of the lanes into rows [first, ..) of columns [c, c + kLanes) of m.
+  void scatter(Eigen::MatrixXd& m, Eigen::Index first, Eigen::Index from, Eigen::Index n,
+               Eigen::Index c) const {
+    for (int l = 0; l < kLanes; ++l) {
+      double* dst = m.col(c + l).data() + first;
+      for (Eigen::Index k = 0; k < n; ++k)
+        dst[k] = data[static_cast<std::size_t>((from + k) * kLanes + l)];
+    }
+  }
+  void z_from(const Eigen::MatrixXd& state, Eigen::Index c) {
+    z.resize(static_cast<std::size_t>(state.rows() * kLanes));
+    for (Eigen::Index i = 0; i < state.rows(); ++i)
+      for (int l = 0; l < kLanes; ++l) z[static_cast<std::size_t>(i * kLanes + l)] = state(i, c + l);
+  }
+  void z_to(Eigen::MatrixXd& state, Eigen::Index c) const {
+    for (Eigen::Index i = 0; i < state.rows(); ++i)
+      for (int l = 0; l < kLanes; ++l) state(i, c + l) = z[static_cast<std::size_t>(i * kLanes + l)];
+  }
+  // Steady state of each lane for its sample k (as unit_state * value, per lane).
+  void z_steady(const Eigen::VectorXd& unit_state, Eigen::Index k) {
+    z.resize(static_cast<std::size_t>(unit_state.size() * kLanes));
+    for (Eigen::Index i = 0; i < unit_state.size(); ++i)
+      for (int l = 0; l < kLanes; ++l)
+        z[static_cast<std::size_t>(i * kLanes + l)] =
+            unit_state(i) * data[static_cast<std::size_t>(k * kLanes + l)];
+  }
+};
 
 }  // namespace
 
@@ -237,9 +282,19 @@ void StreamingZeroPhaseFilter::forward_into_pending(const Eigen::MatrixXd& x) {
   const Eigen::Index m = x.rows();
   make_room(m);
   const Eigen::Index at = pending_first_ + pending_rows_;
-  pending_.middleRows(at, m) = x;
-  for (Eigen::Index c = 0; c < channels_; ++c)
+  Eigen::Index c = 0;
+  Lanes lanes;
+  for (; c + kLanes <= channels_; c += kLanes) {
+    lanes.gather(x, 0, m, c);
+    lanes.z_from(forward_state_, c);
+    detail::run_forward_lanes<kLanes>(sos_, lanes.z.data(), lanes.data.data(), m);
+    lanes.z_to(forward_state_, c);
+    lanes.scatter(pending_, at, 0, m, c);
+  }
+  for (; c < channels_; ++c) {  // the channels left over, one by one: the same operations
+    pending_.col(c).segment(at, m) = x.col(c);
     detail::run_forward(sos_, forward_state_.col(c).data(), pending_.col(c).data() + at, m);
+  }
   pending_rows_ += m;
 }
 
@@ -249,9 +304,19 @@ Eigen::MatrixXd StreamingZeroPhaseFilter::release(Eigen::Index blocks) {
   const Eigen::Index count = blocks * block_;
   const Eigen::Index span = block_ + overlap_;
   Eigen::MatrixXd out(count, channels_);
+  Eigen::Index c = 0;
+  Lanes lanes;
+  for (; c + kLanes <= channels_; c += kLanes) {
+    for (Eigen::Index b = 0; b < blocks; ++b) {
+      lanes.gather(pending_, pending_first_ + b * block_, span, c);
+      lanes.z_steady(unit_state_, span - 1);
+      detail::run_backward_lanes<kLanes>(sos_, lanes.z.data(), lanes.data.data(), span);
+      lanes.scatter(out, b * block_, 0, block_, c);
+    }
+  }
   Eigen::VectorXd sweep(span);
   Eigen::VectorXd z(unit_state_.size());
-  for (Eigen::Index c = 0; c < channels_; ++c) {
+  for (; c < channels_; ++c) {  // the channels left over, one by one: the same operations
     for (Eigen::Index b = 0; b < blocks; ++b) {
       sweep = pending_.col(c).segment(pending_first_ + b * block_, span);
       z = unit_state_ * sweep(span - 1);
