@@ -70,29 +70,36 @@ struct Bound {
 GroupRows collect(const std::string& model, const std::string& group, std::size_t g,
                   const ChannelSet& channels, const RowModel::RowFn& row, const Bound& effects,
                   std::size_t base_width, std::size_t width) {
-  std::vector<double> data;  // row-major
+  std::vector<double> data;  // row-major; each row is built in place at its end
   std::vector<double> ys;
   std::vector<Eigen::Index> samples;
-  std::vector<double> w(width);
+  // Room for a streaming window's rows up front; a whole record's grow as they come (many may
+  // be masked out, so its sample count would over-reserve).
+  const std::size_t most = std::min<std::size_t>(static_cast<std::size_t>(channels.samples()), 4096);
+  data.reserve(most * width);
+  ys.reserve(most);
+  samples.reserve(most);
   for (Eigen::Index k = 0; k < channels.samples(); ++k) {
     if (!channels.valid(k)) continue;
-    std::fill(w.begin(), w.end(), 0.0);
+    const std::size_t at = data.size();
+    data.resize(at + width, 0.0);
+    double* w = data.data() + at;
     double y = 0.0;
-    if (!row(k, g, w.data(), y)) continue;
-    bool keep = true;
+    bool keep = row(k, g, w, y);
     std::size_t offset = base_width;
     for (std::size_t e = 0; keep && e < effects.columns.size(); ++e) {
-      keep = effects.columns[e](k, g, w.data() + offset);
+      keep = effects.columns[e](k, g, w + offset);
       offset += effects.widths[e];
     }
-    if (!keep) continue;
-    const bool finite = std::isfinite(y) && std::all_of(w.begin(), w.end(), [](double v) {
-                          return std::isfinite(v);
-                        });
+    if (!keep) {
+      data.resize(at);
+      continue;
+    }
+    const bool finite =
+        std::isfinite(y) && std::all_of(w, w + width, [](double v) { return std::isfinite(v); });
     if (!finite)
       throw InputError("model '" + model + "': group '" + group + "' has a non-finite row at " +
                        "sample " + std::to_string(k) + " (mark bad samples invalid)");
-    data.insert(data.end(), w.begin(), w.end());
     ys.push_back(y);
     samples.push_back(k);
   }
