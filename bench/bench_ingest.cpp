@@ -11,6 +11,8 @@
 
 #include "dynid/ingest/chunk.hpp"
 #include "dynid/ingest/run_processor.hpp"
+#include "dynid/signal/butterworth.hpp"
+#include "dynid/signal/streaming_zero_phase_filter.hpp"
 #include "load/synthetic_body_run.hpp"
 
 namespace {
@@ -52,6 +54,23 @@ void BM_Process(benchmark::State& state) {
   set_rows(state, run.chunks.size());
 }
 BENCHMARK(BM_Process)->Unit(benchmark::kMillisecond);
+
+// The low-pass alone, as RunProcessor sets it up (the announcement's Butterworth and tolerance),
+// on the same chunks: its share of Process.
+void BM_Filter(benchmark::State& state) {
+  const Run& run = body_run();
+  const dynid::ingest::Preprocessing& pre = run.announcement.preprocessing;
+  const double rate = run.announcement.sample_rate_hz;
+  const dynid::signal::Sos sos =
+      dynid::signal::butterworth_lowpass(pre.butterworth_order, pre.cutoff(rate), rate);
+  for (auto _ : state) {
+    dynid::signal::StreamingZeroPhaseFilter f(sos, run.chunks.front().samples.cols(),
+                                              pre.filter_tolerance);
+    for (const dynid::ingest::Chunk& c : run.chunks) benchmark::DoNotOptimize(f.push(c.samples));
+  }
+  set_rows(state, run.chunks.size());
+}
+BENCHMARK(BM_Filter)->Unit(benchmark::kMillisecond);
 
 void BM_Validate(benchmark::State& state) {
   const Run& run = body_run();

@@ -55,49 +55,86 @@ void impulse_magnitudes(const Sos& sos, Visit visit) {
   }
 }
 
-// Channels run through the cascade kLanes at a time (detail::step_lanes), in a buffer of
-// interleaved samples reused between calls of the same shape.
-constexpr int kLanes = 4;
-
+// Channels run through the cascade L at a time (detail::step_lanes), interleaved in a buffer.
+template <int L>
 struct Lanes {
-  std::vector<double> data;  // sample k of lane l at data[k * kLanes + l]
-  std::vector<double> z;     // delay i of lane l at z[i * kLanes + l]
+  std::vector<double> data;  // sample k of lane l at data[k * L + l]
+  std::vector<double> z;     // delay i of lane l at z[i * L + l]
 
-  // Rows [first, first + n) of columns [c, c + kLanes) of m.
+  // Rows [first, first + n) of columns [c, c + L) of m.
   void gather(const Eigen::MatrixXd& m, Eigen::Index first, Eigen::Index n, Eigen::Index c) {
-    data.resize(static_cast<std::size_t>(n * kLanes));
-    for (int l = 0; l < kLanes; ++l) {
+    data.resize(static_cast<std::size_t>(n * L));
+    for (int l = 0; l < L; ++l) {
       const double* src = m.col(c + l).data() + first;
-      for (Eigen::Index k = 0; k < n; ++k) data[static_cast<std::size_t>(k * kLanes + l)] = src[k];
+      for (Eigen::Index k = 0; k < n; ++k) data[static_cast<std::size_t>(k * L + l)] = src[k];
     }
   }
-  // Rows [from, from + n) of the lanes into rows [first, ..) of columns [c, c + kLanes) of m.
-  void scatter(Eigen::MatrixXd& m, Eigen::Index first, Eigen::Index from, Eigen::Index n,
-               Eigen::Index c) const {
-    for (int l = 0; l < kLanes; ++l) {
+  // The first n rows of the lanes into rows [first, first + n) of columns [c, c + L) of m.
+  void scatter(Eigen::MatrixXd& m, Eigen::Index first, Eigen::Index n, Eigen::Index c) const {
+    for (int l = 0; l < L; ++l) {
       double* dst = m.col(c + l).data() + first;
-      for (Eigen::Index k = 0; k < n; ++k)
-        dst[k] = data[static_cast<std::size_t>((from + k) * kLanes + l)];
+      for (Eigen::Index k = 0; k < n; ++k) dst[k] = data[static_cast<std::size_t>(k * L + l)];
     }
   }
   void z_from(const Eigen::MatrixXd& state, Eigen::Index c) {
-    z.resize(static_cast<std::size_t>(state.rows() * kLanes));
+    z.resize(static_cast<std::size_t>(state.rows() * L));
     for (Eigen::Index i = 0; i < state.rows(); ++i)
-      for (int l = 0; l < kLanes; ++l) z[static_cast<std::size_t>(i * kLanes + l)] = state(i, c + l);
+      for (int l = 0; l < L; ++l) z[static_cast<std::size_t>(i * L + l)] = state(i, c + l);
   }
   void z_to(Eigen::MatrixXd& state, Eigen::Index c) const {
     for (Eigen::Index i = 0; i < state.rows(); ++i)
-      for (int l = 0; l < kLanes; ++l) state(i, c + l) = z[static_cast<std::size_t>(i * kLanes + l)];
+      for (int l = 0; l < L; ++l) state(i, c + l) = z[static_cast<std::size_t>(i * L + l)];
   }
-  // Steady state of each lane for its sample k (as unit_state * value, per lane).
+  // Each lane in steady state for its sample k (unit_state * that value, as the scalar path).
   void z_steady(const Eigen::VectorXd& unit_state, Eigen::Index k) {
-    z.resize(static_cast<std::size_t>(unit_state.size() * kLanes));
+    z.resize(static_cast<std::size_t>(unit_state.size() * L));
     for (Eigen::Index i = 0; i < unit_state.size(); ++i)
-      for (int l = 0; l < kLanes; ++l)
-        z[static_cast<std::size_t>(i * kLanes + l)] =
-            unit_state(i) * data[static_cast<std::size_t>(k * kLanes + l)];
+      for (int l = 0; l < L; ++l)
+        z[static_cast<std::size_t>(i * L + l)] =
+            unit_state(i) * data[static_cast<std::size_t>(k * L + l)];
   }
 };
+
+// Forward pass of rows x[0, m) into pending rows [at, at + m), from column c on, L channels at a
+// time while L are left; returns the first column not done.
+template <int L>
+Eigen::Index forward_lanes(const Sos& sos, const Eigen::MatrixXd& x, Eigen::MatrixXd& pending,
+                           Eigen::Index at, Eigen::MatrixXd& state, Eigen::Index c) {
+  Lanes<L> lanes;
+  for (; c + L <= x.cols(); c += L) {
+    lanes.gather(x, 0, x.rows(), c);
+    lanes.z_from(state, c);
+    detail::run_forward_lanes<L>(sos, lanes.z.data(), lanes.data.data(), x.rows());
+    lanes.z_to(state, c);
+    lanes.scatter(pending, at, x.rows(), c);
+  }
+  return c;
+}
+
+// What a block sweep reads and writes: pending rows from `first`, blocks of `block` released
+// into `out`, each swept backward over `span` samples from steady state.
+struct Sweep {
+  const Sos& sos;
+  const Eigen::VectorXd& unit_state;
+  const Eigen::MatrixXd& pending;
+  Eigen::Index first, blocks, block, span;
+  Eigen::MatrixXd& out;
+};
+
+// Backward sweeps of every block, from column c on, L channels at a time while L are left;
+// returns the first column not done.
+template <int L>
+Eigen::Index sweep_lanes(const Sweep& w, Eigen::Index c) {
+  Lanes<L> lanes;
+  for (; c + L <= w.pending.cols(); c += L)
+    for (Eigen::Index b = 0; b < w.blocks; ++b) {
+      lanes.gather(w.pending, w.first + b * w.block, w.span, c);
+      lanes.z_steady(w.unit_state, w.span - 1);
+      detail::run_backward_lanes<L>(w.sos, lanes.z.data(), lanes.data.data(), w.span);
+      lanes.scatter(w.out, b * w.block, w.block, c);
+    }
+  return c;
+}
 
 }  // namespace
 
@@ -282,16 +319,11 @@ void StreamingZeroPhaseFilter::forward_into_pending(const Eigen::MatrixXd& x) {
   const Eigen::Index m = x.rows();
   make_room(m);
   const Eigen::Index at = pending_first_ + pending_rows_;
-  Eigen::Index c = 0;
-  Lanes lanes;
-  for (; c + kLanes <= channels_; c += kLanes) {
-    lanes.gather(x, 0, m, c);
-    lanes.z_from(forward_state_, c);
-    detail::run_forward_lanes<kLanes>(sos_, lanes.z.data(), lanes.data.data(), m);
-    lanes.z_to(forward_state_, c);
-    lanes.scatter(pending_, at, 0, m, c);
-  }
-  for (; c < channels_; ++c) {  // the channels left over, one by one: the same operations
+  // Wide groups first (more independent chains in flight), then what is left.
+  Eigen::Index c = forward_lanes<8>(sos_, x, pending_, at, forward_state_, 0);
+  c = forward_lanes<4>(sos_, x, pending_, at, forward_state_, c);
+  c = forward_lanes<2>(sos_, x, pending_, at, forward_state_, c);
+  for (; c < channels_; ++c) {  // the last one, if any: the same operations
     pending_.col(c).segment(at, m) = x.col(c);
     detail::run_forward(sos_, forward_state_.col(c).data(), pending_.col(c).data() + at, m);
   }
@@ -304,19 +336,13 @@ Eigen::MatrixXd StreamingZeroPhaseFilter::release(Eigen::Index blocks) {
   const Eigen::Index count = blocks * block_;
   const Eigen::Index span = block_ + overlap_;
   Eigen::MatrixXd out(count, channels_);
-  Eigen::Index c = 0;
-  Lanes lanes;
-  for (; c + kLanes <= channels_; c += kLanes) {
-    for (Eigen::Index b = 0; b < blocks; ++b) {
-      lanes.gather(pending_, pending_first_ + b * block_, span, c);
-      lanes.z_steady(unit_state_, span - 1);
-      detail::run_backward_lanes<kLanes>(sos_, lanes.z.data(), lanes.data.data(), span);
-      lanes.scatter(out, b * block_, 0, block_, c);
-    }
-  }
+  const Sweep w{sos_, unit_state_, pending_, pending_first_, blocks, block_, span, out};
+  Eigen::Index c = sweep_lanes<8>(w, 0);
+  c = sweep_lanes<4>(w, c);
+  c = sweep_lanes<2>(w, c);
   Eigen::VectorXd sweep(span);
   Eigen::VectorXd z(unit_state_.size());
-  for (; c < channels_; ++c) {  // the channels left over, one by one: the same operations
+  for (; c < channels_; ++c) {  // the last one, if any: the same operations
     for (Eigen::Index b = 0; b < blocks; ++b) {
       sweep = pending_.col(c).segment(pending_first_ + b * block_, span);
       z = unit_state_ * sweep(span - 1);
