@@ -6,7 +6,8 @@
 #   BUILD_DIR=build-asan DYNID_SANITIZE=ON bash deploy/setup.sh
 #
 # Environment: BUILD_DIR (default build), DYNID_SANITIZE (ON/OFF), DYNID_WERROR (ON in CI),
-# JOBS (default: number of cores).
+# JOBS (default: number of cores), DYNID_DEBUG_INFO (ON/OFF: -g in the default RelWithDebInfo build;
+# CI sets OFF).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -29,5 +30,6 @@ werror=${DYNID_WERROR:-$([ "${CI:-}" = true ] && echo ON || echo OFF)}
 mkdir -p "$build_dir"
 cmake -S . -B "$build_dir" -DDYNID_WERROR="$werror" -DDYNID_SANITIZE="${DYNID_SANITIZE:-OFF}" \
   -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-RelWithDebInfo}" -DDYNID_BUILD_BENCHMARKS="${DYNID_BUILD_BENCHMARKS:-ON}" \
+  -DDYNID_DEBUG_INFO="${DYNID_DEBUG_INFO:-ON}" \
   > "$build_dir/configure.log" 2>&1 || { cat "$build_dir/configure.log"; exit 1; }
 cmake --build "$build_dir" -j "${JOBS:-$(nproc)}"
