@@ -115,6 +115,23 @@ TEST(EffectScreen, TheRoadProfileFindsAnUnmeasuredGrade) {
   EXPECT_GT(screen.best()->held_out_drop, 0.5);
 }
 
+// A declared road profile keeps its columns last: a candidate model effect is tested against the
+// model with the profile, not against a shuffled column set.
+TEST(EffectScreen, TestsCandidatesBesideADeclaredRoadProfile) {
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  const auto run = hilly_run(0.0);
+  ScreenOptions options;
+  options.only = {"road_grade", "dict:sq:vx"};
+  const ScreenResult screen = screen_effects(*model, {"road_grade_profile"}, run, kRate, 1, options);
+  ASSERT_EQ(screen.candidates.size(), 2U);
+  for (const CandidateScore& c : screen.candidates) {
+    EXPECT_TRUE(c.evaluated) << c.effect << ": " << c.note;
+    EXPECT_EQ(c.columns, 1U) << c.effect;
+    EXPECT_GE(c.in_sample_drop, 0.0) << c.effect;  // nested models: adding a column never hurts in sample
+  }
+  EXPECT_EQ(screen.candidates.front().effect, "road_grade");  // the exact grade beats its piecewise-linear profile
+}
+
 TEST(EffectScreen, SaysSoWhenNothingIsSignificant) {
   const auto model = model::make_model("kinematic_longitudinal", {});
   auto run = hilly_run(0.05);

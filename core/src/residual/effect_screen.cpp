@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <numeric>
 
 #include "dynid/error.hpp"
 #include "dynid/model/effects.hpp"
@@ -81,19 +80,21 @@ std::vector<Candidate> candidates_of(const model::Model& m, const std::vector<st
   return out;
 }
 
-// Weighted sums of squares of the model without the candidate (first `base` columns) and with
+// Weighted sums of squares of the model without the candidate (every column but the last
+// effect's: a declared road profile's columns come after it) and with
 // it, on the candidate's rows, under the declared model's fixed group weights.
-CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, Eigen::Index base,
-                     const std::vector<double>& weights, double min_drop) {
-  std::vector<Eigen::Index> base_columns(static_cast<std::size_t>(base));
-  std::iota(base_columns.begin(), base_columns.end(), Eigen::Index{0});
+CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, const std::vector<double>& weights,
+                     double min_drop) {
+  std::vector<Eigen::Index> base_columns;
+  for (Eigen::Index j = 0; j < static_cast<Eigen::Index>(rows.parameters.size()); ++j)
+    if (j < rows.last_effect_first || j >= rows.last_effect_end) base_columns.push_back(j);
   const detail::Evaluation before = detail::evaluate(rows, base_columns, weights);
   const detail::Evaluation after = detail::evaluate(rows, {}, weights);
   CandidateScore s;
   s.effect = c.effect;
   s.description = c.description;
   s.kind = c.kind;
-  s.columns = rows.parameters.size() - static_cast<std::size_t>(base);
+  s.columns = static_cast<std::size_t>(rows.last_effect_end - rows.last_effect_first);
   s.rows = after.total_rows();
   s.evaluated = true;
   const double ss_before = before.weighted_in();
@@ -171,13 +172,12 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
   for (const GroupFit& g : result.fit.groups) weights.push_back(g.sigma > 0.0 ? 1.0 / g.sigma : 0.0);
   FitOptions fold_options = options.fit;
   fold_options.series = false;
-  const auto base = static_cast<Eigen::Index>(model.parameters_with(declared).size());
   for (const Candidate& c : candidates_of(model, declared, run, options)) {
     std::vector<std::string> with = declared;
     with.push_back(c.effect);
     try {
       const detail::FoldedRows rows = detail::fold_rows(model, with, run, sample_rate_hz, odmf, fold_options, false);
-      result.candidates.push_back(score(c, rows, base, weights, options.min_held_out_drop));
+      result.candidates.push_back(score(c, rows, weights, options.min_held_out_drop));
     } catch (const InputError& e) {
       CandidateScore s;
       s.effect = c.effect;
