@@ -156,6 +156,9 @@ TEST(EffectScreen, NamesWhyACandidateCannotBeTested) {
   CrossValidation bad;
   bad.folds = 1;
   EXPECT_THROW(bad.validate(), InputError);
+  FitOptions wrong_weights;
+  wrong_weights.group_weights = {1.0, 2.0};  // the model has one group
+  EXPECT_THROW(fit_model(*kin, {}, run, kRate, 1, wrong_weights), InputError);
 }
 
 TEST(RecordedRun, RejectsMissingOrDisorderedChunksNamingThem) {

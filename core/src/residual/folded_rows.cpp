@@ -206,6 +206,9 @@ std::uint64_t Evaluation::total_rows() const {
 Evaluation evaluate(const FoldedRows& rows, const std::vector<Eigen::Index>& columns,
                     const std::vector<double>& weights) {
   const std::vector<std::string>& names = rows.groups;
+  if (!weights.empty() && weights.size() != names.size())
+    throw InputError("residual analysis: " + std::to_string(weights.size()) + " group weights for " +
+                     std::to_string(names.size()) + " equation groups");
   std::vector<ls::EquationGroups> folds;
   for (const ls::EquationGroups& f : rows.folds) folds.push_back(selected(f, columns, names));
   Evaluation e;

@@ -72,8 +72,8 @@ struct FitOptions {
 };
 
 /// Fits `model` with `effects` (model, dictionary or road-profile effects; at most one road
-/// profile) on the run. InputError when the model lacks a channel, an effect is unknown or no
-/// row is left.
+/// profile) on the run. InputError when the model lacks a channel, an effect is unknown, no
+/// row is left, or group_weights has not one weight per group.
 ModelFit fit_model(const model::Model& model, const std::vector<std::string>& effects,
                    const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
                    int odmf, const FitOptions& options = {});
