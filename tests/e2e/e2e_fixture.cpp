@@ -118,6 +118,13 @@ std::optional<int> ServerProcess::wait(std::chrono::milliseconds timeout) {
   return std::nullopt;
 }
 
+CommandResult run_dynid(const std::vector<std::string>& arguments, int timeout_s, dds_domainid_t domain) {
+  std::vector<std::string> argv{DYNID_CLI_EXE, "--cyclone-config", loopback_config(), "--domain",
+                                std::to_string(domain), "--timeout", std::to_string(timeout_s)};
+  argv.insert(argv.end(), arguments.begin(), arguments.end());
+  return run_command(argv, std::chrono::seconds(2 * timeout_s));
+}
+
 CommandResult run_command(const std::vector<std::string>& arguments,
                           std::chrono::milliseconds timeout) {
   int out[2], err[2];

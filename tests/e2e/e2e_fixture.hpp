@@ -82,6 +82,10 @@ struct CommandResult {
 };
 /// Runs a program (no shell) and captures its output; exit_code -1 on timeout (then killed).
 CommandResult run_command(const std::vector<std::string>& argv, std::chrono::milliseconds timeout);
+/// The dynid CLI (DYNID_CLI_EXE) with the loopback configuration on `domain`, its request
+/// timeout `timeout_s`; killed after twice that.
+CommandResult run_dynid(const std::vector<std::string>& arguments, int timeout_s = 10,
+                        dds_domainid_t domain = kDomain);
 
 /// A car: announces runs and publishes chunks of one vehicle, reads its acknowledgements.
 class TestCar {

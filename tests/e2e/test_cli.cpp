@@ -6,12 +6,7 @@
 namespace dynid::e2e {
 namespace {
 
-CommandResult dynid(std::vector<std::string> arguments, dds_domainid_t domain = kDomain) {
-  std::vector<std::string> argv{DYNID_CLI_EXE, "--cyclone-config", loopback_config(), "--domain",
-                                std::to_string(domain), "--timeout", "10"};
-  argv.insert(argv.end(), arguments.begin(), arguments.end());
-  return run_command(argv, 20s);
-}
+CommandResult dynid(const std::vector<std::string>& arguments) { return run_dynid(arguments); }
 
 TEST(E2eCli, EstimatesTableAgainstRunningServer) {
   TempDir dir;

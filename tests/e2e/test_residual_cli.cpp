@@ -9,12 +9,7 @@
 namespace dynid::e2e {
 namespace {
 
-CommandResult dynid(std::vector<std::string> arguments) {
-  std::vector<std::string> argv{DYNID_CLI_EXE, "--cyclone-config", loopback_config(), "--domain",
-                                std::to_string(kDomain), "--timeout", "30"};
-  argv.insert(argv.end(), arguments.begin(), arguments.end());
-  return run_command(argv, 60s);
-}
+CommandResult dynid(const std::vector<std::string>& arguments) { return run_dynid(arguments, 30); }
 
 TEST(E2eResidualCli, RanksEffectsAndWritesTheBeforeAfterReport) {
   TempDir dir;
