@@ -79,7 +79,7 @@ RunService::RunState& RunService::load_from_store(const store::RunKey& key) {
   if (closed && !run.processor.finished()) run.processor.finish();
   spdlog::info("run {}: resumed at #{} ({} stored contiguously{})", label(key), from,
                run.contiguous + 1, closed ? ", closed" : "");
-  run.dirty = true;
+  mark_changed(run);
   return run;
 }
 
@@ -263,7 +263,7 @@ void RunService::fold_ready(const store::RunKey& key, RunState& run,
         break;
       }
       context_.counters.add(&CounterSnapshot::chunks_folded);
-      run.dirty = true;
+      mark_changed(run);
       if (++run.since_checkpoint >= context_.options.checkpoint_every) take_checkpoint(key, run);
     }
     if (!run.halted.empty()) break;
@@ -357,6 +357,21 @@ void RunService::publish_tables(const std::string& vehicle, EstimateTables table
   }
 }
 
+void RunService::publish_pending(const std::string& vehicle) {
+  std::vector<std::pair<const store::RunKey*, RunState*>> changed;
+  for (auto& [key, run] : runs_)
+    if (key.vehicle == vehicle && run->dirty) changed.emplace_back(&key, run.get());
+  std::sort(changed.begin(), changed.end(),
+            [](const auto& a, const auto& b) { return a.second->changed < b.second->changed; });
+  for (const auto& [key, run] : changed) {
+    try {
+      publish(*key, *run);
+    } catch (const std::exception& e) {
+      spdlog::error("run {}: estimates not published: {}", label(*key), e.what());
+    }
+  }
+}
+
 void RunService::settle() {
   flush_pending();
   if (!unsaved_.empty()) save_folds(std::exchange(unsaved_, {}));  // no next batch to ride on
@@ -364,14 +379,12 @@ void RunService::settle() {
 
 void RunService::publish_due(std::chrono::steady_clock::time_point now) {
   settle();
-  for (auto& [key, run] : runs_) {
-    if (!run->dirty || now - run->last_published < context_.options.publish_interval) continue;
-    try {
-      publish(key, *run);
-    } catch (const std::exception& e) {
-      spdlog::error("run {}: estimates not published: {}", label(key), e.what());
-    }
-  }
+  std::vector<std::string> due;  // runs_ is ordered by vehicle: a vehicle's runs are adjacent
+  for (const auto& [key, run] : runs_)
+    if (run->dirty && now - run->last_published >= context_.options.publish_interval &&
+        (due.empty() || due.back() != key.vehicle))
+      due.push_back(key.vehicle);
+  for (const auto& vehicle : due) publish_pending(vehicle);
 }
 
 void RunService::record_history(const store::RunKey& key, const EstimateTables& tables) {

@@ -127,6 +127,7 @@ EstimateTables RunService::pooled(const std::string& vehicle, const std::vector<
   }
   if (model && out.tables.empty() && out.notes.empty())
     throw NotFound("pooled: run " + runs.front() + " has no model " + *model);
+  publish_pending(vehicle);  // the pool comes last: no throttled run table overtakes it
   publish_tables(vehicle, out);
   return out;
 }

@@ -251,11 +251,42 @@ bool EstimateWatcher::wait(
   for (;;) {
     if (done(latest_)) return true;
     if (std::chrono::steady_clock::now() >= deadline) return false;
-    for (auto& sample : reader_.wait_take(50ms)) {
-      auto table = dds::from_wire(sample.data);
-      if (table.vehicle != vehicle_) ++foreign_;
-      latest_[table.model] = table;
-    }
+    take(50ms);
+  }
+}
+
+bool EstimateWatcher::wait_for(const std::vector<Reference>& expected, const std::string& source,
+                               std::chrono::milliseconds patience) {
+  const auto deadline = std::chrono::steady_clock::now() + patience;
+  for (;;) {
+    if (rows_match(expected, latest(source), source)) return true;
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    take(50ms);
+  }
+}
+
+const std::map<std::string, dds::EstimateTable>& EstimateWatcher::latest(const std::string& source) const {
+  static const std::map<std::string, dds::EstimateTable> none;
+  const auto it = by_source_.find(source);
+  return it == by_source_.end() ? none : it->second;
+}
+
+std::string EstimateWatcher::seen() const {
+  std::string out;
+  for (const auto& [source, tables] : by_source_) {
+    out += source + ":";
+    for (const auto& [model, table] : tables) out += " " + model + " rows " + std::to_string(table.rows);
+    out += "; ";
+  }
+  return out.empty() ? "nothing" : out;
+}
+
+void EstimateWatcher::take(std::chrono::milliseconds timeout) {
+  for (auto& sample : reader_.wait_take(timeout)) {
+    auto table = dds::from_wire(sample.data);
+    if (table.vehicle != vehicle_) ++foreign_;
+    by_source_[table.source][table.model] = table;
+    latest_[table.model] = std::move(table);
   }
 }
 

@@ -120,20 +120,35 @@ class TestCar {
   std::vector<dds::ChunkReceipt> seen_;  // every receipt, in arrival order
 };
 
-/// Estimates of one vehicle as published (latest per model), checked by the vehicle id.
+struct Reference;
+
+/// Estimates of one vehicle as published, checked by the vehicle id. Kept per source as well
+/// as overall: a run's throttled publication may arrive after a pool's, so a test waiting for
+/// one source must not have it replaced by another.
 class EstimateWatcher {
  public:
   explicit EstimateWatcher(const std::string& vehicle);
   /// Waits until the latest table of every model satisfies `done`; false at the deadline.
   bool wait(const std::function<bool(const std::map<std::string, dds::EstimateTable>&)>& done,
             std::chrono::milliseconds patience = kPatience);
+  /// Waits until every expected model is published from `source` with the expected row count.
+  bool wait_for(const std::vector<Reference>& expected, const std::string& source,
+                std::chrono::milliseconds patience = kPatience);
+  /// The latest table per model, whatever its source.
   const std::map<std::string, dds::EstimateTable>& latest() const { return latest_; }
+  /// The latest table per model from `source` (empty when none came).
+  const std::map<std::string, dds::EstimateTable>& latest(const std::string& source) const;
   std::size_t foreign() const { return foreign_; }  ///< tables of another vehicle (crosstalk)
+  /// What was seen, for a failure message: per source, each model's latest row count.
+  std::string seen() const;
 
  private:
+  void take(std::chrono::milliseconds timeout);
+
   std::string vehicle_;
   dds::Reader<dynid_wire_Estimate> reader_;
   std::map<std::string, dds::EstimateTable> latest_;
+  std::map<std::string, std::map<std::string, dds::EstimateTable>> by_source_;
   std::size_t foreign_ = 0;
 };
 

@@ -111,15 +111,15 @@ TEST(E2eBadInput, MalformedChunksAreRejectedWithReasonsAndChangeNothing) {
   ASSERT_TRUE(car.deliver(chunks, 1));
   EstimateWatcher bad_watcher("bad-car");
   const auto expected = references(offline(run, chunks).estimates());
-  ASSERT_TRUE(bad_watcher.wait([&](const auto& latest) { return rows_match(expected, latest, "run-b"); }));
-  for (const auto& reference : expected) expect_equal(reference, bad_watcher.latest().at(reference.model));
+  ASSERT_TRUE(bad_watcher.wait_for(expected, "run-b"));
+  for (const auto& reference : expected) expect_equal(reference, bad_watcher.latest("run-b").at(reference.model));
   EXPECT_GE(server.server().counters().chunks_duplicate, 1u);
 
   good_car.join();
   EstimateWatcher good_watcher("good-car");
   const auto good_expected = references(offline(good, good_chunks).estimates());
-  ASSERT_TRUE(good_watcher.wait([&](const auto& latest) { return rows_match(good_expected, latest, "run-g"); }));
-  for (const auto& reference : good_expected) expect_equal(reference, good_watcher.latest().at(reference.model));
+  ASSERT_TRUE(good_watcher.wait_for(good_expected, "run-g"));
+  for (const auto& reference : good_expected) expect_equal(reference, good_watcher.latest("run-g").at(reference.model));
   EXPECT_EQ(server.server().counters().chunks_folded, chunks.size() + good_chunks.size())
       << "each chunk folded once: no rejected one, no duplicate";
 }

@@ -17,7 +17,7 @@ TEST(E2eCli, EstimatesTableAgainstRunningServer) {
   ASSERT_TRUE(car.stream(run.announcement, chunks));
   const auto expected = references(offline(run, chunks).estimates());
   EstimateWatcher watcher("cli-car");
-  ASSERT_TRUE(watcher.wait([&](const auto& latest) { return rows_match(expected, latest, "run-c"); }));
+  ASSERT_TRUE(watcher.wait_for(expected, "run-c"));
 
   const auto table = dynid({"estimates", "--vehicle", "cli-car"});
   ASSERT_EQ(table.exit_code, 0) << table.err;
@@ -25,7 +25,7 @@ TEST(E2eCli, EstimatesTableAgainstRunningServer) {
                                  "rel.std%", "status", "mass", "kg", "identified", "rows ",
                                  "sigma", "cond", "residual RMS", "kinematic_longitudinal"})
     EXPECT_NE(table.out.find(word), std::string::npos) << "missing '" << word << "' in\n" << table.out;
-  const std::string rows = "rows " + std::to_string(watcher.latest().at("longitudinal_wheel").rows);
+  const std::string rows = "rows " + std::to_string(watcher.latest("run-c").at("longitudinal_wheel").rows);
   EXPECT_NE(table.out.find(rows), std::string::npos) << table.out;
 
   const auto json = dynid({"--json", "estimates", "--vehicle", "cli-car", "--model", "locked_driveline"});

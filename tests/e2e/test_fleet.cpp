@@ -55,25 +55,25 @@ TEST(E2eFleet, ThreeVehiclesNoCrosstalkAndPooledRuns) {
     for (const auto& stream : streams) processors[vehicle].push_back(offline(stream.run, stream.chunks));
     const auto& last = streams.back().run.announcement.run;
     const auto expected = references(processors[vehicle].back().estimates());
-    ASSERT_TRUE(watchers[vehicle]->wait([&](const auto& latest) { return rows_match(expected, latest, last); }))
+    ASSERT_TRUE(watchers[vehicle]->wait_for(expected, last))
         << vehicle;
-    for (const auto& reference : expected) expect_equal(reference, watchers[vehicle]->latest().at(reference.model));
+    for (const auto& reference : expected) expect_equal(reference, watchers[vehicle]->latest(last).at(reference.model));
     EXPECT_EQ(watchers[vehicle]->foreign(), 0u) << vehicle << " saw another vehicle's estimates";
   }
-  EXPECT_NE(watchers["car-b"]->latest().at("longitudinal_wheel").parameters[0].value,
-            watchers["car-c"]->latest().at("longitudinal_wheel").parameters[0].value);
+  EXPECT_NE(watchers["car-b"]->latest("b-1").at("longitudinal_wheel").parameters[0].value,
+            watchers["car-c"]->latest("c-1").at("longitudinal_wheel").parameters[0].value);
 
   const auto reply = request("pooled", {{"vehicle", "car-a"}, {"run", "a-1"}, {"run", "a-2"}});
   ASSERT_EQ(reply.status, dds::ReplyStatus::kOk) << reply.error;
   const std::vector<const ingest::RunProcessor*> runs{&processors["car-a"][0], &processors["car-a"][1]};
   std::vector<Reference> expected;
   for (std::size_t m = 0; m < runs.front()->model_count(); ++m) expected.push_back(pooled_reference(runs, m));
-  ASSERT_TRUE(watchers["car-a"]->wait([&](const auto& latest) { return rows_match(expected, latest, "pool:a-1+a-2"); }));
-  for (const auto& reference : expected) expect_equal(reference, watchers["car-a"]->latest().at(reference.model));
+  ASSERT_TRUE(watchers["car-a"]->wait_for(expected, "pool:a-1+a-2")) << "seen " << watchers["car-a"]->seen();
+  for (const auto& reference : expected) expect_equal(reference, watchers["car-a"]->latest("pool:a-1+a-2").at(reference.model));
   // The pool holds both runs' rows.
   EXPECT_EQ(expected[0].rows, processors["car-a"][0].estimates()[0].estimate->estimate.rows +
                                   processors["car-a"][1].estimates()[0].estimate->estimate.rows);
-  const auto& mass = watchers["car-a"]->latest().at("longitudinal_wheel").parameters[0];
+  const auto& mass = watchers["car-a"]->latest("pool:a-1+a-2").at("longitudinal_wheel").parameters[0];
   EXPECT_NEAR(mass.value, ingest::test::Truth{}.mass, 0.05 * ingest::test::Truth{}.mass);
 }
 

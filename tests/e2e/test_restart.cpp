@@ -46,9 +46,9 @@ TEST(E2eRestart, SigkillMidRunLosesNothingAndFoldsNothingTwice) {
   ASSERT_TRUE(car.deliver(chunks, before_kill)) << log_of(dir);
 
   const auto expected = references(offline(run, chunks).estimates());
-  ASSERT_TRUE(watcher.wait([&](const auto& latest) { return rows_match(expected, latest, "run-k"); }))
+  ASSERT_TRUE(watcher.wait_for(expected, "run-k"))
       << log_of(dir);
-  for (const auto& reference : expected) expect_equal(reference, watcher.latest().at(reference.model));
+  for (const auto& reference : expected) expect_equal(reference, watcher.latest("run-k").at(reference.model));
 
   // The ledger, as the running server sees it: everything stored is folded, once.
   const auto runs = request("runs", {{"vehicle", "restart-car"}, {"format", "json"}});

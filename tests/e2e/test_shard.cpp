@@ -79,8 +79,7 @@ std::vector<Reference> expected(const Vehicle& v, std::size_t end, bool closed =
 }
 
 bool published(Vehicle& v, const std::vector<Reference>& references) {
-  return v.watcher->wait(
-      [&](const auto& latest) { return rows_match(references, latest, v.run.announcement.run); });
+  return v.watcher->wait_for(references, v.run.announcement.run);
 }
 
 // Closed by its owner: shard `owner` of `count` (0 of 0 for one server that does not say).
@@ -151,7 +150,7 @@ std::map<std::string, std::map<std::string, dds::EstimateTable>> single_server_r
   for (auto& v : vehicles) {
     close_run(v, 0, 1);
     EXPECT_TRUE(published(v, expected(v, v.chunks.size(), true))) << v.id;
-    out[v.id] = v.watcher->latest();
+    out[v.id] = v.watcher->latest(v.run.announcement.run);
   }
   return out;
 }
@@ -271,8 +270,8 @@ TEST(E2eShard, TwoServersOwnTheirVehiclesAndOneStoppingDisturbsNotTheOther) {
     close_run(v, v.owner, kShards);
     ASSERT_TRUE(published(v, expected(v, v.chunks.size(), true))) << v.id << "\n" << (v.owner ? one : zero).log_text();
     for (const auto& [model, table] : single.at(v.id)) {
-      ASSERT_TRUE(v.watcher->latest().count(model)) << v.id << " " << model;
-      expect_same_tables(v.watcher->latest().at(model), table);
+      ASSERT_TRUE(v.watcher->latest(v.run.announcement.run).count(model)) << v.id << " " << model;
+      expect_same_tables(v.watcher->latest(v.run.announcement.run).at(model), table);
     }
     EXPECT_EQ(v.watcher->foreign(), 0u);
   }

@@ -20,22 +20,22 @@ TEST(E2eStreaming, PublishedEstimateEqualsOfflineProcessor) {
   auto processor = offline(run, chunks);
   const auto streaming = references(processor.estimates());
   ASSERT_EQ(streaming.size(), 3u) << "every model of the test run has an estimate";
-  ASSERT_TRUE(watcher.wait([&](const auto& latest) { return rows_match(streaming, latest, "run-1"); }))
+  ASSERT_TRUE(watcher.wait_for(streaming, "run-1"))
       << "no estimate with the offline row counts was published: " << [&] {
            std::string s;
            for (const auto& [m, t] : watcher.latest()) s += m + " " + t.source + " rows " + std::to_string(t.rows) + "; ";
            for (const auto& r : streaming) s += "expected " + r.model + " " + std::to_string(r.rows) + "; ";
            return s;
          }();
-  for (const auto& expected : streaming) expect_equal(expected, watcher.latest().at(expected.model));
+  for (const auto& expected : streaming) expect_equal(expected, watcher.latest("run-1").at(expected.model));
 
   // Closing folds the samples held back for the filter's look-ahead: compare with finish().
   const auto reply = request("close", {{"vehicle", "stream-car"}, {"run", "run-1"}});
   ASSERT_EQ(reply.status, dds::ReplyStatus::kOk) << reply.error;
   processor.finish();
   const auto closed = references(processor.estimates());
-  ASSERT_TRUE(watcher.wait([&](const auto& latest) { return rows_match(closed, latest, "run-1"); }));
-  for (const auto& expected : closed) expect_equal(expected, watcher.latest().at(expected.model));
+  ASSERT_TRUE(watcher.wait_for(closed, "run-1"));
+  for (const auto& expected : closed) expect_equal(expected, watcher.latest("run-1").at(expected.model));
   EXPECT_NE(reply.payload.find("longitudinal_wheel"), std::string::npos) << reply.payload;
 
   const auto counters = server.server().counters();

@@ -16,6 +16,10 @@
 //      state taken right after that chunk, with its estimate history entry), are saved in the next
 //      batch's transaction, or on the next tick when no chunk came: one fsync per batch
 //   -> the run's estimates are published at most every `publish_interval` (publish_due).
+//      The Estimate instance is (vehicle, model), shared by the vehicle's runs and pools, and
+//      readers keep its latest sample. So a vehicle's changed runs are published together, the
+//      most recently changed last, and a pool after them: an older run's throttled table never
+//      overtakes a newer run's, nor the pool an engineer just asked for.
 // A chunk is acknowledged only once its batch has committed: never before it is durable. A
 // rejected chunk (unknown run, invalid, conflicting, too far ahead, closed run) is counted,
 // listed in the ack with its reason, and changes no state. A store failure acknowledges
@@ -132,7 +136,8 @@ class RunService {
     std::uint64_t since_checkpoint = 0;
     std::deque<dds::ChunkRejection> rejections;
     std::string halted;
-    bool dirty = false;
+    bool dirty = false;         // estimates changed since the last publication
+    std::uint64_t changed = 0;  // when, on the service's change counter (orders publications)
     std::chrono::steady_clock::time_point last_published{};
     std::optional<std::uint64_t> unsaved_fold;  // folded through, not yet in the ledger
     std::vector<UnsavedCheckpoint> unsaved_checkpoints;
@@ -168,6 +173,13 @@ class RunService {
   void save_unsaved(store::Store& s);
   void publish(const store::RunKey& key, RunState& run);
   void publish_tables(const std::string& vehicle, EstimateTables tables);
+  /// Publishes now every run of `vehicle` whose estimates changed since their last publication,
+  /// in the order they changed.
+  void publish_pending(const std::string& vehicle);
+  void mark_changed(RunState& run) {
+    run.dirty = true;
+    run.changed = ++changes_;
+  }
   void record_history(const store::RunKey& key, const EstimateTables& tables);
   void record_history(store::Store& s, const store::RunKey& key, const EstimateTables& tables);
   std::string latest_run(const std::string& vehicle);
@@ -175,6 +187,7 @@ class RunService {
   ServerContext& context_;
   std::map<store::RunKey, std::unique_ptr<RunState>> runs_;
   std::vector<PendingChunk> pending_;  // received, validated, not yet stored
+  std::uint64_t changes_ = 0;          // RunState::changed counter
   std::vector<store::RunKey> unsaved_;  // runs whose folded mark or checkpoint is not saved
   VehicleOutputs outputs_;
 };
