@@ -27,12 +27,11 @@ struct ModelRun {
   std::string note;
 };
 
-// Rows of one model built on one ready window, and which of them to fold: new (not context,
-// not look-ahead) and on the decimation grid.
+// Rows of one model built on one ready window: only at its new samples (not context, not
+// look-ahead) on the decimation grid, so every row is folded.
 struct FoldJob {
   std::size_t model;
   std::vector<model::GroupRows> rows;
-  std::vector<std::vector<Eigen::Index>> selected;  // per group, rows of `rows`, increasing
 };
 
 // Every channel a model reads: its own, and the enabled effects'.
@@ -199,24 +198,18 @@ void RunProcessor::Impl::collect(detail::SegmentStream& seg, bool at_end, RunCou
   const auto decimation = static_cast<std::uint64_t>(announcement.preprocessing.odmf);
   const detail::ReadyRows ready = seg.ready(at_end);
   if (ready.new_count == 0) return;
-  const model::ChannelSet set = channel_set(ready.rows);
-  for (std::size_t m = 0; m < models.size(); ++m) {
-    if (!models[m].model) continue;
-    FoldJob job{m, models[m].model->rows(set, models[m].spec.effects), {}};
-    // Rows of the context (already folded) and of the look-ahead (not final) are left out, and
-    // so are the samples off the decimation grid: the run's grid index decides, not where a
-    // chunk or a filter block begins.
-    for (const model::GroupRows& g : job.rows) {
-      const auto first = std::lower_bound(g.samples.begin(), g.samples.end(), ready.first_new);
-      const auto last = std::lower_bound(first, g.samples.end(), ready.first_new + ready.new_count);
-      std::vector<Eigen::Index>& keep = job.selected.emplace_back();
-      for (auto it = first; it != last; ++it) {
-        const std::uint64_t grid =
-            seg.start_index() + static_cast<std::uint64_t>(ready.first_index + *it);
-        if (grid % decimation == 0) keep.push_back(it - g.samples.begin());
-      }
-    }
-    jobs.push_back(std::move(job));
+  // The samples of the context (already folded) and of the look-ahead (not final) are left
+  // out, and so are those off the decimation grid: the run's grid index decides, not where a
+  // chunk or a filter block begins. Rows are built at the kept samples only.
+  std::vector<Eigen::Index> grid;
+  const std::uint64_t first = seg.start_index() + static_cast<std::uint64_t>(ready.first_index);
+  for (Eigen::Index k = ready.first_new; k < ready.first_new + ready.new_count; ++k)
+    if ((first + static_cast<std::uint64_t>(k)) % decimation == 0) grid.push_back(k);
+  if (!grid.empty()) {
+    const model::ChannelSet set = channel_set(ready.rows);
+    for (std::size_t m = 0; m < models.size(); ++m)
+      if (models[m].model)
+        jobs.push_back({m, models[m].model->rows_at(set, grid, models[m].spec.effects)});
   }
   c.final_samples += static_cast<std::uint64_t>(ready.new_count);
   seg.consume(ready.new_count);
@@ -238,18 +231,8 @@ void RunProcessor::Impl::end_segment(detail::SegmentStream& seg, RunCounters& c,
 
 void RunProcessor::Impl::fold(const std::vector<FoldJob>& jobs) {
   for (const FoldJob& job : jobs)
-    for (std::size_t g = 0; g < job.rows.size(); ++g) {
-      const std::vector<Eigen::Index>& keep = job.selected[g];
-      if (keep.empty()) continue;
-      const model::GroupRows& rows = job.rows[g];
-      if (keep.back() - keep.front() + 1 == static_cast<Eigen::Index>(keep.size())) {
-        const auto count = static_cast<Eigen::Index>(keep.size());
-        models[job.model].groups->fold(g, rows.W.middleRows(keep.front(), count),
-                                       rows.y.segment(keep.front(), count));
-      } else {
-        models[job.model].groups->fold(g, rows.W(keep, Eigen::all), rows.y(keep));
-      }
-    }
+    for (std::size_t g = 0; g < job.rows.size(); ++g)
+      if (job.rows[g].W.rows() > 0) models[job.model].groups->fold(g, job.rows[g].W, job.rows[g].y);
 }
 
 detail::SegmentStream& RunProcessor::Impl::working_copy() {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ranges>
 
 #include "dictionary.hpp"
 #include "dynid/error.hpp"
@@ -67,19 +68,21 @@ struct Bound {
   std::vector<std::size_t> widths;
 };
 
+// Rows of group g at `samples` (a range of increasing sample indices).
+template <typename Samples>
 GroupRows collect(const std::string& model, const std::string& group, std::size_t g,
-                  const ChannelSet& channels, const RowModel::RowFn& row, const Bound& effects,
-                  std::size_t base_width, std::size_t width) {
+                  const ChannelSet& channels, const Samples& samples, const RowModel::RowFn& row,
+                  const Bound& effects, std::size_t base_width, std::size_t width) {
   std::vector<double> data;  // row-major; each row is built in place at its end
   std::vector<double> ys;
-  std::vector<Eigen::Index> samples;
+  std::vector<Eigen::Index> kept;
   // Room for a streaming window's rows up front; a whole record's grow as they come (many may
   // be masked out, so its sample count would over-reserve).
-  const std::size_t most = std::min<std::size_t>(static_cast<std::size_t>(channels.samples()), 4096);
+  const std::size_t most = std::min<std::size_t>(std::ranges::size(samples), 4096);
   data.reserve(most * width);
   ys.reserve(most);
-  samples.reserve(most);
-  for (Eigen::Index k = 0; k < channels.samples(); ++k) {
+  kept.reserve(most);
+  for (const Eigen::Index k : samples) {
     if (!channels.valid(k)) continue;
     const std::size_t at = data.size();
     data.resize(at + width, 0.0);
@@ -101,20 +104,37 @@ GroupRows collect(const std::string& model, const std::string& group, std::size_
       throw InputError("model '" + model + "': group '" + group + "' has a non-finite row at " +
                        "sample " + std::to_string(k) + " (mark bad samples invalid)");
     ys.push_back(y);
-    samples.push_back(k);
+    kept.push_back(k);
   }
   const auto m = static_cast<Eigen::Index>(ys.size());
   const auto n = static_cast<Eigen::Index>(width);
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   GroupRows out{group, Eigen::Map<const RowMajor>(data.data(), m, n),
-                Eigen::Map<const Eigen::VectorXd>(ys.data(), m), std::move(samples)};
+                Eigen::Map<const Eigen::VectorXd>(ys.data(), m), std::move(kept)};
   return out;
+}
+
+// InputError unless `samples` are increasing indices of a set of `count` samples.
+void check_selection(const std::string& model, const std::vector<Eigen::Index>& samples,
+                     Eigen::Index count) {
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const Eigen::Index k = samples[i];
+    if (k < 0 || k >= count)
+      throw InputError("model '" + model + "': selected sample " + std::to_string(k) +
+                       " (position " + std::to_string(i) + ") is outside the " +
+                       std::to_string(count) + " samples");
+    if (i > 0 && k <= samples[i - 1])
+      throw InputError("model '" + model + "': selected samples are not increasing at position " +
+                       std::to_string(i) + " (" + std::to_string(samples[i - 1]) + " then " +
+                       std::to_string(k) + ")");
+  }
 }
 
 }  // namespace
 
-std::vector<GroupRows> RowModel::rows(const ChannelSet& channels,
-                                      const std::vector<std::string>& effects) const {
+template <typename Samples>
+std::vector<GroupRows> RowModel::build(const ChannelSet& channels, const Samples& samples,
+                                       const std::vector<std::string>& effects) const {
   check_channels(channels);
   const std::vector<EffectDefinition> defs = resolve(channels, effects);
   const RowFn row = bind(channels, effects);
@@ -129,8 +149,20 @@ std::vector<GroupRows> RowModel::rows(const ChannelSet& channels,
   const std::vector<std::string> names = groups();
   std::vector<GroupRows> out;
   for (std::size_t g = 0; g < names.size(); ++g)
-    out.push_back(collect(name(), names[g], g, channels, row, bound, base_width, width));
+    out.push_back(collect(name(), names[g], g, channels, samples, row, bound, base_width, width));
   return out;
+}
+
+std::vector<GroupRows> RowModel::rows(const ChannelSet& channels,
+                                      const std::vector<std::string>& effects) const {
+  return build(channels, std::views::iota(Eigen::Index{0}, channels.samples()), effects);
+}
+
+std::vector<GroupRows> RowModel::rows_at(const ChannelSet& channels,
+                                         const std::vector<Eigen::Index>& samples,
+                                         const std::vector<std::string>& effects) const {
+  check_selection(name(), samples, channels.samples());
+  return build(channels, samples, effects);
 }
 
 }  // namespace dynid::model

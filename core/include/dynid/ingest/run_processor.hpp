@@ -41,7 +41,8 @@
 // Errors (strong guarantee: a rejected call changes no state, so the caller can count it and go
 // on): push() throws InputError for an invalid chunk, a sequence other than next_sequence(), a
 // first_sample_index other than next_sample_index() (after the first chunk), after finish(), or
-// when a model rejects the data (a non-finite row: the reason names the model and sample).
+// when a model rejects the data (a non-finite row at a sample it folds: the reason names the
+// model and sample; rows are built only on the decimation grid, see Pipeline).
 #include <cstdint>
 #include <memory>
 #include <optional>

@@ -73,6 +73,15 @@ class Model {
   /// for channels that cannot give a sound estimate (constant where excitation is needed, ...).
   virtual std::vector<GroupRows> rows(const ChannelSet& channels,
                                       const std::vector<std::string>& effects = {}) const = 0;
+  /// Rows of every group at the chosen samples only: `samples` are sample indices of
+  /// `channels`, strictly increasing. Each row is exactly (bit for bit) the row rows() builds at
+  /// that sample, since a row still reads its neighbours (lags, validity of adjacent samples)
+  /// from the whole `channels`; a chosen sample that is invalid or masked gives no row. For a
+  /// caller that keeps only some samples (the decimation grid) and would discard the rest.
+  /// Throws InputError as rows() does, and for a selection out of range or not increasing.
+  virtual std::vector<GroupRows> rows_at(const ChannelSet& channels,
+                                         const std::vector<Eigen::Index>& samples,
+                                         const std::vector<std::string>& effects = {}) const = 0;
 
   /// The reach of a row at this sample period (s), with every effect: the default covers the
   /// dictionary and one-sample neighbour tests; a model that reads further (a masking rule

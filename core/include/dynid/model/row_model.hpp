@@ -22,6 +22,9 @@ class RowModel : public Model {
   std::vector<Effect> candidate_effects() const final;
   std::vector<GroupRows> rows(const ChannelSet& channels,
                               const std::vector<std::string>& effects = {}) const final;
+  std::vector<GroupRows> rows_at(const ChannelSet& channels,
+                                 const std::vector<Eigen::Index>& samples,
+                                 const std::vector<std::string>& effects = {}) const final;
 
   /// Fills `w` (parameters().size() entries, zeroed) and `y` for group `group` at sample k;
   /// returns false to leave the row out.
@@ -45,6 +48,9 @@ class RowModel : public Model {
   void check_channels(const ChannelSet& channels) const;
   std::vector<EffectDefinition> resolve(const ChannelSet& channels,
                                         const std::vector<std::string>& effects) const;
+  template <typename Samples>
+  std::vector<GroupRows> build(const ChannelSet& channels, const Samples& samples,
+                               const std::vector<std::string>& effects) const;
 };
 
 /// True when `name` is among the enabled `effects`.
