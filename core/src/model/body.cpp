@@ -122,19 +122,27 @@ RowModel::RowFn BodyModel::bind(const ChannelSet& set, const std::vector<std::st
   std::vector<const Eigen::VectorXd*> hubs;  // per corner: fx fy fz mx my mz
   for (const char* corner : kCorners)
     for (const char* part : kWrench) hubs.push_back(&set[std::string("hub_") + part + "_" + corner]);
-  return [motion, hubs, hub = hub_](Eigen::Index k, std::size_t group, double* w, double& y) {
-    auto at = [&](std::size_t i) { return (*motion[i])(k); };
-    const Eigen::Matrix<double, 6, 10> d =
-        regressor({at(0), at(1), at(2)}, {at(3), at(4), at(5)}, {at(6), at(7), at(8)});
+  // The regressor and the wrench of the last sample: the six groups of a sample come one after
+  // the other (RowModel::RowFn), so each sample's are computed once, not once per group.
+  Eigen::Index cached = -1;
+  Eigen::Matrix<double, 6, 10> d = Eigen::Matrix<double, 6, 10>::Zero();
+  Eigen::Matrix<double, 6, 1> wrench = Eigen::Matrix<double, 6, 1>::Zero();
+  return [motion, hubs, hub = hub_, cached, d, wrench](Eigen::Index k, std::size_t group, double* w,
+                                                       double& y) mutable {
+    if (k != cached) {
+      auto at = [&](std::size_t i) { return (*motion[i])(k); };
+      d = regressor({at(0), at(1), at(2)}, {at(3), at(4), at(5)}, {at(6), at(7), at(8)});
+      wrench.setZero();
+      for (std::size_t c = 0; c < hub.size(); ++c) {
+        auto part = [&](std::size_t j) { return (*hubs[6 * c + j])(k); };
+        const Eigen::Vector3d f(part(0), part(1), part(2));
+        wrench.head<3>() += f;
+        wrench.tail<3>() += Eigen::Vector3d(part(3), part(4), part(5)) + hub[c].cross(f);
+      }
+      cached = k;
+    }
     Eigen::Map<Eigen::Matrix<double, 1, 10>> columns(w);
     columns = d.row(static_cast<Eigen::Index>(group));
-    Eigen::Matrix<double, 6, 1> wrench = Eigen::Matrix<double, 6, 1>::Zero();
-    for (std::size_t c = 0; c < hub.size(); ++c) {
-      auto part = [&](std::size_t j) { return (*hubs[6 * c + j])(k); };
-      const Eigen::Vector3d f(part(0), part(1), part(2));
-      wrench.head<3>() += f;
-      wrench.tail<3>() += Eigen::Vector3d(part(3), part(4), part(5)) + hub[c].cross(f);
-    }
     y = wrench(static_cast<Eigen::Index>(group));
     return true;
   };

@@ -68,49 +68,66 @@ struct Bound {
   std::vector<std::size_t> widths;
 };
 
-// Rows of group g at `samples` (a range of increasing sample indices).
-template <typename Samples>
-GroupRows collect(const std::string& model, const std::string& group, std::size_t g,
-                  const ChannelSet& channels, const Samples& samples, const RowModel::RowFn& row,
-                  const Bound& effects, std::size_t base_width, std::size_t width) {
-  std::vector<double> data;  // row-major; each row is built in place at its end
+// One group's rows as they are built: row-major, each row built in place at the end.
+struct GroupBuffer {
+  std::vector<double> data;
   std::vector<double> ys;
   std::vector<Eigen::Index> kept;
+};
+
+// Rows of every group at `samples` (a range of increasing sample indices), sample by sample,
+// every group of a sample before the next sample: a model computing what its groups share
+// (the body's 6 x 10 regressor) does it once per sample (RowModel::RowFn).
+template <typename Samples>
+std::vector<GroupRows> collect(const std::string& model, const std::vector<std::string>& groups,
+                               const ChannelSet& channels, const Samples& samples,
+                               const RowModel::RowFn& row, const Bound& effects,
+                               std::size_t base_width, std::size_t width) {
   // Room for a streaming window's rows up front; a whole record's grow as they come (many may
   // be masked out, so its sample count would over-reserve).
   const std::size_t most = std::min<std::size_t>(std::ranges::size(samples), 4096);
-  data.reserve(most * width);
-  ys.reserve(most);
-  kept.reserve(most);
+  std::vector<GroupBuffer> buffers(groups.size());
+  for (GroupBuffer& b : buffers) {
+    b.data.reserve(most * width);
+    b.ys.reserve(most);
+    b.kept.reserve(most);
+  }
   for (const Eigen::Index k : samples) {
     if (!channels.valid(k)) continue;
-    const std::size_t at = data.size();
-    data.resize(at + width, 0.0);
-    double* w = data.data() + at;
-    double y = 0.0;
-    bool keep = row(k, g, w, y);
-    std::size_t offset = base_width;
-    for (std::size_t e = 0; keep && e < effects.columns.size(); ++e) {
-      keep = effects.columns[e](k, g, w + offset);
-      offset += effects.widths[e];
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      GroupBuffer& b = buffers[g];
+      const std::size_t at = b.data.size();
+      b.data.resize(at + width, 0.0);
+      double* w = b.data.data() + at;
+      double y = 0.0;
+      bool keep = row(k, g, w, y);
+      std::size_t offset = base_width;
+      for (std::size_t e = 0; keep && e < effects.columns.size(); ++e) {
+        keep = effects.columns[e](k, g, w + offset);
+        offset += effects.widths[e];
+      }
+      if (!keep) {
+        b.data.resize(at);
+        continue;
+      }
+      const bool finite =
+          std::isfinite(y) && std::all_of(w, w + width, [](double v) { return std::isfinite(v); });
+      if (!finite)
+        throw InputError("model '" + model + "': group '" + groups[g] +
+                         "' has a non-finite row at sample " + std::to_string(k) +
+                         " (mark bad samples invalid)");
+      b.ys.push_back(y);
+      b.kept.push_back(k);
     }
-    if (!keep) {
-      data.resize(at);
-      continue;
-    }
-    const bool finite =
-        std::isfinite(y) && std::all_of(w, w + width, [](double v) { return std::isfinite(v); });
-    if (!finite)
-      throw InputError("model '" + model + "': group '" + group + "' has a non-finite row at " +
-                       "sample " + std::to_string(k) + " (mark bad samples invalid)");
-    ys.push_back(y);
-    kept.push_back(k);
   }
-  const auto m = static_cast<Eigen::Index>(ys.size());
-  const auto n = static_cast<Eigen::Index>(width);
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  GroupRows out{group, Eigen::Map<const RowMajor>(data.data(), m, n),
-                Eigen::Map<const Eigen::VectorXd>(ys.data(), m), std::move(kept)};
+  std::vector<GroupRows> out;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    GroupBuffer& b = buffers[g];
+    const auto m = static_cast<Eigen::Index>(b.ys.size());
+    out.push_back({groups[g], Eigen::Map<const RowMajor>(b.data.data(), m, static_cast<Eigen::Index>(width)),
+                   Eigen::Map<const Eigen::VectorXd>(b.ys.data(), m), std::move(b.kept)});
+  }
   return out;
 }
 
@@ -146,11 +163,7 @@ std::vector<GroupRows> RowModel::build(const ChannelSet& channels, const Samples
     bound.widths.push_back(d.info.parameters.size());
     width += d.info.parameters.size();
   }
-  const std::vector<std::string> names = groups();
-  std::vector<GroupRows> out;
-  for (std::size_t g = 0; g < names.size(); ++g)
-    out.push_back(collect(name(), names[g], g, channels, samples, row, bound, base_width, width));
-  return out;
+  return collect(name(), groups(), channels, samples, row, bound, base_width, width);
 }
 
 std::vector<GroupRows> RowModel::rows(const ChannelSet& channels,

@@ -27,7 +27,9 @@ class RowModel : public Model {
                                  const std::vector<std::string>& effects = {}) const final;
 
   /// Fills `w` (parameters().size() entries, zeroed) and `y` for group `group` at sample k;
-  /// returns false to leave the row out.
+  /// returns false to leave the row out. rows() calls it for every group of a sample, in group
+  /// order, before the next sample, so a bound function may keep what its groups share for the
+  /// last sample (the body's regressor) instead of computing it once per group.
   using RowFn = std::function<bool(Eigen::Index k, std::size_t group, double* w, double& y)>;
   /// Fills an effect's columns (its parameters().size() entries, zeroed); false leaves the row
   /// out (e.g. a lag reaching an invalid sample).
