@@ -2,6 +2,8 @@
 //   - Process: the load benchmark's body-model run (bench/load/synthetic_body_run.hpp: 10
 //     parameters, 30 channels, 100 Hz, odmf 8) pushed through ingest::RunProcessor in chunks of
 //     100 rows (validation, zero-phase filter, rows, fold), as the server does for each chunk;
+//   - ProcessValidated: the same with chunks validated beforehand (ValidatedChunk), as the
+//     server validates each chunk on arrival;
 //   - Validate / Encode / Decode / Checksum: the per-chunk steps the server adds around it
 //     (validate_chunk, the store's encoding and its inverse, the CRC-32 of a chunk).
 // items/s = sample rows/s. Chunks are made before timing (the vehicles' work, not the server's).
@@ -11,6 +13,7 @@
 
 #include "dynid/ingest/chunk.hpp"
 #include "dynid/ingest/run_processor.hpp"
+#include "dynid/ingest/validated_chunk.hpp"
 #include "dynid/signal/butterworth.hpp"
 #include "dynid/signal/streaming_zero_phase_filter.hpp"
 #include "load/synthetic_body_run.hpp"
@@ -54,6 +57,24 @@ void BM_Process(benchmark::State& state) {
   set_rows(state, run.chunks.size());
 }
 BENCHMARK(BM_Process)->Unit(benchmark::kMillisecond);
+
+// Process of chunks the caller validated already (ValidatedChunk, made before the timing as
+// the server makes them on arrival): push() without its second validation.
+void BM_ProcessValidated(benchmark::State& state) {
+  const Run& run = body_run();
+  std::vector<dynid::ingest::ValidatedChunk> chunks;
+  for (const dynid::ingest::Chunk& c : run.chunks)
+    chunks.push_back(dynid::ingest::ValidatedChunk::validate(c, run.announcement));
+  for (auto _ : state) {
+    state.PauseTiming();
+    dynid::ingest::RunProcessor p(run.announcement);
+    state.ResumeTiming();
+    for (const dynid::ingest::ValidatedChunk& c : chunks) p.push(c);
+    benchmark::DoNotOptimize(p.counters());
+  }
+  set_rows(state, chunks.size());
+}
+BENCHMARK(BM_ProcessValidated)->Unit(benchmark::kMillisecond);
 
 // The low-pass alone, as RunProcessor sets it up (the announcement's Butterworth and tolerance),
 // on the same chunks: its share of Process.

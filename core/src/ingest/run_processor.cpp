@@ -107,6 +107,8 @@ struct RunProcessor::Impl {
   void end_segment(detail::SegmentStream& seg, RunCounters& c, std::vector<FoldJob>& jobs) const;
   void fold(const std::vector<FoldJob>& jobs);
   detail::SegmentStream& working_copy();
+  /// RunProcessor::push; `validated`: validate_chunk passed for this announcement and limits.
+  void push(const Chunk& chunk, bool validated);
 };
 
 RunProcessor::Impl::Impl(RunAnnouncement a, ChunkLimits l)
@@ -251,20 +253,27 @@ RunProcessor::RunProcessor(RunProcessor&&) noexcept = default;
 RunProcessor& RunProcessor::operator=(RunProcessor&&) noexcept = default;
 
 void RunProcessor::push(const Chunk& chunk) {
-  Impl& s = *impl_;
+  impl_->push(chunk, false);
+}
+
+void RunProcessor::push(const ValidatedChunk& chunk) {
+  impl_->push(chunk.chunk(), chunk.validated_for(impl_->announcement, impl_->limits));
+}
+
+void RunProcessor::Impl::push(const Chunk& chunk, bool validated) {
   const std::string where =
       "chunk " + chunk.vehicle + "/" + chunk.run + "#" + std::to_string(chunk.sequence) + ": ";
-  if (s.finished) throw InputError(where + "the run is finished");
-  validate_chunk(chunk, s.announcement, s.limits);
-  if (chunk.sequence != s.next_sequence)
-    throw InputError(where + "out of order, expected sequence " + std::to_string(s.next_sequence));
-  if (s.counters.chunks > 0 && chunk.first_sample_index != s.next_index)
+  if (finished) throw InputError(where + "the run is finished");
+  if (!validated) validate_chunk(chunk, announcement, limits);
+  if (chunk.sequence != next_sequence)
+    throw InputError(where + "out of order, expected sequence " + std::to_string(next_sequence));
+  if (counters.chunks > 0 && chunk.first_sample_index != next_index)
     throw InputError(where + "starts at sample " + std::to_string(chunk.first_sample_index) +
-                     ", expected " + std::to_string(s.next_index) +
+                     ", expected " + std::to_string(next_index) +
                      " (gaps are sent as invalid rows, not skipped)");
   // Work on copies of the stream state: a model rejecting the data leaves everything unchanged.
-  detail::SegmentStream& seg = s.working_copy();
-  RunCounters c = s.counters;
+  detail::SegmentStream& seg = working_copy();
+  RunCounters c = counters;
   std::vector<FoldJob> jobs;
   const Eigen::Index m = chunk.samples.rows();
   for (Eigen::Index k = 0; k < m;) {
@@ -274,20 +283,20 @@ void RunProcessor::push(const Chunk& chunk) {
     if (flag == 1) {
       if (!seg.active()) seg.start(chunk.first_sample_index + static_cast<std::uint64_t>(k));
       seg.push(chunk.samples.middleRows(k, e - k));
-      s.collect(seg, false, c, jobs);
+      collect(seg, false, c, jobs);
     } else {
-      s.end_segment(seg, c, jobs);
+      end_segment(seg, c, jobs);
       c.invalid_samples += static_cast<std::uint64_t>(e - k);
     }
     k = e;
   }
-  s.fold(jobs);
-  std::swap(s.segment, s.scratch);
-  s.counters = c;
-  ++s.counters.chunks;
-  s.counters.samples += static_cast<std::uint64_t>(m);
-  ++s.next_sequence;
-  s.next_index = chunk.first_sample_index + static_cast<std::uint64_t>(m);
+  fold(jobs);
+  std::swap(segment, scratch);
+  counters = c;
+  ++counters.chunks;
+  counters.samples += static_cast<std::uint64_t>(m);
+  ++next_sequence;
+  next_index = chunk.first_sample_index + static_cast<std::uint64_t>(m);
 }
 
 void RunProcessor::finish() {

@@ -27,6 +27,8 @@ struct ChunkLimits {
   /// Largest |value| accepted: nothing a vehicle channel in SI reaches (pressures ~1e7 Pa),
   /// and far enough from overflow that squares and sums in the accumulators stay finite.
   double max_abs_value = 1e15;
+
+  bool operator==(const ChunkLimits&) const = default;
 };
 
 struct Chunk {

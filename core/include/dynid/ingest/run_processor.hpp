@@ -2,7 +2,8 @@
 // RunProcessor: the server's processing of one vehicle-run, chunk by chunk (DYCARO's
 // script_filtre -> script_obs -> script_ident, streamed). One per run; DDS-free.
 //
-// Pipeline. Every chunk is validated (validate_chunk, then sequence and grid continuity); its
+// Pipeline. Every chunk is validated (validate_chunk unless it comes as a ValidatedChunk of this
+// run under the same limits, then sequence and grid continuity); its
 // valid samples go through one StreamingZeroPhaseFilter per valid segment (all channels but the
 // announcement's `unfiltered` ones, which are delayed to stay aligned), the `d_<name>` channels
 // that the models need and the run does not measure come from a StreamingDerivative of the
@@ -52,6 +53,7 @@
 
 #include "dynid/ingest/chunk.hpp"
 #include "dynid/ingest/run_announcement.hpp"
+#include "dynid/ingest/validated_chunk.hpp"
 #include "dynid/ls/equation_groups.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/signal/sos.hpp"
@@ -97,6 +99,11 @@ class RunProcessor {
   RunProcessor& operator=(RunProcessor&&) noexcept;
 
   void push(const Chunk& chunk);
+  /// push() of a chunk the caller has validated already (the server validates each chunk as
+  /// it arrives, before storing it): validate_chunk is not run again when the chunk was
+  /// validated for this run's ids and channel count under this processor's limits
+  /// (ValidatedChunk::validated_for), and is run again otherwise. Same errors and guarantee.
+  void push(const ValidatedChunk& chunk);
   /// Ends the run: flushes the last segment. Throws InputError when already finished.
   void finish();
 
