@@ -22,10 +22,13 @@ void ChannelSet::add(const std::string& name, const std::string& unit, Eigen::Ve
   if (values.size() != samples_)
     throw InputError("channel set: channel '" + name + "' has " + std::to_string(values.size()) +
                      " samples, the set has " + std::to_string(samples_));
-  for (Eigen::Index k = 0; k < samples_; ++k)
-    if (valid(k) && !std::isfinite(values(k)))
-      throw InputError("channel set: channel '" + name + "' is not finite at sample " +
-                       std::to_string(k) + " (mark the stretch invalid first)");
+  // The usual all-finite channel is checked at vector speed; only one with a NaN/Inf is looked
+  // at sample by sample, where the validity flags decide.
+  if (!values.allFinite())
+    for (Eigen::Index k = 0; k < samples_; ++k)
+      if (valid(k) && !std::isfinite(values(k)))
+        throw InputError("channel set: channel '" + name + "' is not finite at sample " +
+                         std::to_string(k) + " (mark the stretch invalid first)");
   channels_.emplace(name, Channel{unit, std::move(values)});
 }
 
