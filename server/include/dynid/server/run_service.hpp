@@ -95,7 +95,8 @@ class RunService {
   void reject_unreadable(const std::string& vehicle, const std::string& run,
                          std::uint64_t sequence, const std::string& reason);
   void resume(const store::RunKey& key);
-  /// The worker's tick: stores, acknowledges and folds the queued chunks (flush_pending), then
+  /// The worker's tick: stores, acknowledges and folds the queued chunks (flush_pending); when
+  /// there were none (idle), saves the folded marks and checkpoints still unsaved; then
   /// publishes the estimates of runs that changed and whose interval has passed.
   void publish_due(std::chrono::steady_clock::time_point now);
   /// Stores, acknowledges and folds the chunks receive_chunk queued (see above).
