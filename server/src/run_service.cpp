@@ -79,7 +79,7 @@ RunService::RunState& RunService::load_from_store(const store::RunKey& key) {
   if (closed && !run.processor.finished()) run.processor.finish();
   spdlog::info("run {}: resumed at #{} ({} stored contiguously{})", label(key), from,
                run.contiguous + 1, closed ? ", closed" : "");
-  mark_changed(run);
+  mark_changed(key, run);
   return run;
 }
 
@@ -263,7 +263,7 @@ void RunService::fold_ready(const store::RunKey& key, RunState& run,
         break;
       }
       context_.counters.add(&CounterSnapshot::chunks_folded);
-      mark_changed(run);
+      mark_changed(key, run);
       if (++run.since_checkpoint >= context_.options.checkpoint_every) take_checkpoint(key, run);
     }
     if (!run.halted.empty()) break;
@@ -343,7 +343,7 @@ void RunService::publish_ack(const store::RunKey& key, const RunState* run,
 }
 
 void RunService::publish(const store::RunKey& key, RunState& run) {
-  run.dirty = false;
+  dirty_.erase(key);
   run.last_published = std::chrono::steady_clock::now();
   publish_tables(key.vehicle, tables_of(key.vehicle, key.run, run.processor.estimates()));
 }
@@ -357,17 +357,23 @@ void RunService::publish_tables(const std::string& vehicle, EstimateTables table
   }
 }
 
+void RunService::mark_changed(const store::RunKey& key, RunState& run) {
+  run.changed = ++changes_;
+  dirty_.insert(key);
+}
+
 void RunService::publish_pending(const std::string& vehicle) {
-  std::vector<std::pair<const store::RunKey*, RunState*>> changed;
-  for (auto& [key, run] : runs_)
-    if (key.vehicle == vehicle && run->dirty) changed.emplace_back(&key, run.get());
+  std::vector<std::pair<store::RunKey, RunState*>> changed;
+  // dirty_ is ordered by vehicle: its changed runs are adjacent, from the first with its name.
+  for (auto it = dirty_.lower_bound({vehicle, {}}); it != dirty_.end() && it->vehicle == vehicle; ++it)
+    if (RunState* run = find(*it)) changed.emplace_back(*it, run);
   std::sort(changed.begin(), changed.end(),
             [](const auto& a, const auto& b) { return a.second->changed < b.second->changed; });
   for (const auto& [key, run] : changed) {
     try {
-      publish(*key, *run);
+      publish(key, *run);
     } catch (const std::exception& e) {
-      spdlog::error("run {}: estimates not published: {}", label(*key), e.what());
+      spdlog::error("run {}: estimates not published: {}", label(key), e.what());
     }
   }
 }
@@ -384,11 +390,19 @@ void RunService::publish_due(std::chrono::steady_clock::time_point now) {
   const bool idle = pending_.empty();
   flush_pending();
   if (idle && !unsaved_.empty()) save_folds(std::exchange(unsaved_, {}));
-  std::vector<std::string> due;  // runs_ is ordered by vehicle: a vehicle's runs are adjacent
-  for (const auto& [key, run] : runs_)
-    if (run->dirty && now - run->last_published >= context_.options.publish_interval &&
-        (due.empty() || due.back() != key.vehicle))
-      due.push_back(key.vehicle);
+  // Only the changed runs are visited (a worker of 1000 vehicles ticks after every batch).
+  std::vector<std::string> due;  // dirty_ is ordered by vehicle: a vehicle's runs are adjacent
+  for (auto it = dirty_.begin(); it != dirty_.end();) {
+    const RunState* run = find(*it);
+    if (!run) {  // unloaded (a failed load): nothing left to publish
+      it = dirty_.erase(it);
+      continue;
+    }
+    if (now - run->last_published >= context_.options.publish_interval &&
+        (due.empty() || due.back() != it->vehicle))
+      due.push_back(it->vehicle);
+    ++it;
+  }
   for (const auto& vehicle : due) publish_pending(vehicle);
 }
 

@@ -43,6 +43,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <variant>
 #include <vector>
@@ -137,8 +138,7 @@ class RunService {
     std::uint64_t since_checkpoint = 0;
     std::deque<dds::ChunkRejection> rejections;
     std::string halted;
-    bool dirty = false;         // estimates changed since the last publication
-    std::uint64_t changed = 0;  // when, on the service's change counter (orders publications)
+    std::uint64_t changed = 0;  // when it last changed, on changes_ (orders publications)
     std::chrono::steady_clock::time_point last_published{};
     std::optional<std::uint64_t> unsaved_fold;  // folded through, not yet in the ledger
     std::vector<UnsavedCheckpoint> unsaved_checkpoints;
@@ -177,10 +177,8 @@ class RunService {
   /// Publishes now every run of `vehicle` whose estimates changed since their last publication,
   /// in the order they changed.
   void publish_pending(const std::string& vehicle);
-  void mark_changed(RunState& run) {
-    run.dirty = true;
-    run.changed = ++changes_;
-  }
+  /// The run's estimates changed since their last publication (dirty_).
+  void mark_changed(const store::RunKey& key, RunState& run);
   void record_history(const store::RunKey& key, const EstimateTables& tables);
   void record_history(store::Store& s, const store::RunKey& key, const EstimateTables& tables);
   std::string latest_run(const std::string& vehicle);
@@ -189,6 +187,7 @@ class RunService {
   std::map<store::RunKey, std::unique_ptr<RunState>> runs_;
   std::vector<PendingChunk> pending_;  // received, validated, not yet stored
   std::uint64_t changes_ = 0;          // RunState::changed counter
+  std::set<store::RunKey> dirty_;      // runs whose estimates changed since their publication
   std::vector<store::RunKey> unsaved_;  // runs whose folded mark or checkpoint is not saved
   VehicleOutputs outputs_;
 };
