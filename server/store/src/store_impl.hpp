@@ -10,6 +10,7 @@
 
 #include "dynid/store/store.hpp"
 #include "sqlite.hpp"
+#include "wal_checkpointer.hpp"
 
 namespace dynid::store {
 
@@ -92,6 +93,9 @@ struct Store::Impl {
       "SELECT r.name, r.closed_ns, l.contiguous_through, l.folded_through, "
       "(SELECT count(*) FROM chunks c WHERE c.run_id = r.id) FROM runs r "
       "JOIN ledger l ON l.run_id = r.id WHERE r.vehicle_id = ?1 ORDER BY r.id"};
+
+  // Last: destroyed first, before the connection it hooks (wal_checkpointer.hpp).
+  detail::WalCheckpointer checkpointer{db};
 
   /// The run, from the cache or the file (then cached); nullptr if never announced.
   const detail::RunRow* lookup(const RunKey& key);
