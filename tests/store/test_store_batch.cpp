@@ -2,7 +2,10 @@
 // it is rolled back alone; a batch that throws leaves nothing; a batch cannot nest.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <filesystem>
 #include <stdexcept>
+#include <thread>
 
 #include "dynid/error.hpp"
 #include "store_test_support.hpp"
@@ -56,6 +59,29 @@ TEST(StoreBatch, ABatchThatThrowsLeavesNothing) {
                std::runtime_error);
   EXPECT_FALSE(store.highest_contiguous({"car", "r1"}));
   EXPECT_EQ(store.store_chunk(chunk("car", "r1", 0)).status, ChunkStatus::stored);  // usable
+}
+
+// The writer's commits do not copy the log back into the database file (they would wait for
+// it): a thread of the store does, on its own connection. 100 commits of ~25 KB are ~600 pages,
+// below SQLite's own 1000-page autocheckpoint: they reach the file while the store is open.
+TEST(StoreBatch, TheLogIsCopiedIntoTheFileWhileTheStoreIsOpen) {
+  TempDir dir;
+  const std::string path = dir.file("log.db");
+  Store store(path);
+  store.add_run(announcement("car", "r1"));
+  constexpr std::uint64_t kChunks = 100;
+  for (std::uint64_t k = 0; k < kChunks; ++k)
+    ASSERT_EQ(store.store_chunk(chunk("car", "r1", k, 1000)).status, ChunkStatus::stored);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (std::filesystem::file_size(path) < 2'000'000 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_GE(std::filesystem::file_size(path), 2'000'000u) << "the log was not checkpointed";
+  auto stream = store.chunks({"car", "r1"}, 0, kChunks - 1);
+  for (std::uint64_t k = 0; k < kChunks; ++k) {
+    const auto stored = stream.next();
+    ASSERT_TRUE(stored);
+    EXPECT_TRUE(same(*stored, chunk("car", "r1", k, 1000)));
+  }
 }
 
 TEST(StoreBatch, CannotNest) {
