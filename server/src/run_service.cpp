@@ -15,6 +15,7 @@ namespace {
 constexpr std::size_t kMaxRejectionsKept = 64;  // = dynid_wire_kMaxRejections
 constexpr std::uint64_t kReplayBatch = 16;      // chunks read from the store per lock
 constexpr std::size_t kMaxBatch = 256;          // chunks stored per transaction at most
+constexpr std::size_t kMaxInFlight = 2;         // batches a worker has at the committer at most
 
 std::string label(const store::RunKey& key) { return key.vehicle + "/" + key.run; }
 
@@ -142,50 +143,123 @@ void RunService::reject_unreadable(const std::string& vehicle, const std::string
   reject(key, find(key), sequence, reason);
 }
 
-void RunService::receive_chunk(const ingest::Chunk& chunk) {
-  const store::RunKey key{chunk.vehicle, chunk.run};
+void RunService::receive_chunk(std::shared_ptr<const ingest::Chunk> chunk) {
+  const store::RunKey key{chunk->vehicle, chunk->run};
   RunState* run = find(key);
   if (!run) {
     try {
       run = &load(key);  // a run announced before a restart, or never announced
     } catch (const NotFound&) {
-      return reject(key, nullptr, chunk.sequence, "unknown run " + label(key) + " (never announced)");
+      return reject(key, nullptr, chunk->sequence, "unknown run " + label(key) + " (never announced)");
     }
   }
   try {
-    ingest::validate_chunk(chunk, run->processor.announcement(), context_.options.store.limits);
+    ingest::validate_chunk(*chunk, run->processor.announcement(), context_.options.store.limits);
   } catch (const InputError& e) {
-    return reject(key, run, chunk.sequence, e.what());
+    return reject(key, run, chunk->sequence, e.what());
   }
-  pending_.push_back({key, chunk});
-  if (pending_.size() >= kMaxBatch) flush_pending();
+  pending_.push_back({key, std::move(chunk)});
+  if (pending_.size() >= kMaxBatch) submit_pending();
 }
 
 void RunService::flush_pending() {
-  if (pending_.empty()) return;
-  std::vector<PendingChunk> batch;
-  batch.swap(pending_);
-  const auto results = store_batch(batch);
-  if (results.empty()) return;  // not stored: nothing acknowledged, the cars resend
+  submit_pending();
+  collect(true);
+}
+
+// Hands the queued chunks, with the folded marks and checkpoints not yet saved (they ride
+// along: one fsync for all), to the committer; the worker folds on meanwhile.
+void RunService::submit_pending() {
+  if (!pending_.empty()) submit(pending_);
+}
+
+// `chunks` (moved out) and the unsaved marks and checkpoints as one batch to the committer.
+void RunService::submit(std::vector<PendingChunk>& chunks) {
+  while (in_flight_.size() >= kMaxInFlight) collect_one(true);  // bounds the memory held
+  auto batch = std::make_shared<InFlight>();
+  batch->chunks.swap(chunks);
+  batch->folds = take_unsaved(std::exchange(unsaved_, {}));
+  batch->results.resize(batch->chunks.size());
+  in_flight_.push_back(batch);
+  context_.committer.submit(
+      [batch, &counters = context_.counters](store::Store& s) {
+        write_folds(s, batch->folds, counters);
+        for (std::size_t i = 0; i < batch->chunks.size(); ++i) {
+          try {
+            batch->results[i] = s.store_chunk(*batch->chunks[i].chunk);
+          } catch (const InputError& e) {  // rolled back alone; the others stay
+            batch->results[i] = std::string(e.what());
+          }
+        }
+      },
+      [batch, wake = wake_](bool committed, const std::string& error) {
+        {
+          std::lock_guard lock(batch->mutex);
+          batch->done = true;
+          batch->committed = committed;
+          batch->error = error;
+        }
+        batch->finished.notify_all();
+        if (wake) wake();
+      });
+}
+
+void RunService::collect_committed() { collect(false); }
+
+void RunService::collect(bool wait) {
+  while (!in_flight_.empty() && collect_one(wait)) {
+  }
+}
+
+// The oldest batch in flight, once committed: acknowledged and folded. False when it is not
+// done yet and `wait` is false.
+bool RunService::collect_one(bool wait) {
+  const std::shared_ptr<InFlight> batch = in_flight_.front();
+  {
+    std::unique_lock lock(batch->mutex);
+    if (!wait && !batch->done) return false;
+    batch->finished.wait(lock, [&] { return batch->done; });
+  }
+  in_flight_.pop_front();
+  if (!batch->committed) {  // not stored: nothing acknowledged, the cars resend
+    if (batch->chunks.empty()) {
+      spdlog::error("folded marks and checkpoints of {} runs not saved: {}", batch->folds.size(),
+                    batch->error);
+      return true;
+    }
+    context_.counters.add(&CounterSnapshot::store_errors, batch->chunks.size());
+    spdlog::error("{} chunks not stored ({}#{}..): {}", batch->chunks.size(),
+                  label(batch->chunks.front().key), batch->chunks.front().chunk->sequence,
+                  batch->error);
+    return true;
+  }
+  apply(*batch);
+  return true;
+}
+
+// A committed batch: every chunk's outcome into its run, one ack per run, then the folds.
+void RunService::apply(const InFlight& batch) {
   std::vector<store::RunKey> touched;  // runs with news, in arrival order
   std::map<store::RunKey, std::vector<const ingest::Chunk*>> stored;
-  for (std::size_t i = 0; i < batch.size(); ++i) {
-    const store::RunKey& key = batch[i].key;
-    RunState& run = *find(key);  // loaded by receive_chunk; only a failed load unloads a run
-    if (const auto* refused = std::get_if<std::string>(&results[i])) {
-      reject(key, &run, batch[i].chunk.sequence, *refused);
+  for (std::size_t i = 0; i < batch.chunks.size(); ++i) {
+    const store::RunKey& key = batch.chunks[i].key;
+    const ingest::Chunk& chunk = *batch.chunks[i].chunk;
+    RunState* run = find(key);  // loaded by receive_chunk; only its own failed load unloads it
+    if (!run) continue;         // stored all the same: a later load replays it
+    if (const auto* refused = std::get_if<std::string>(&batch.results[i])) {
+      reject(key, run, chunk.sequence, *refused);
       continue;
     }
-    const auto& result = std::get<store::StoreChunkResult>(results[i]);
-    run.contiguous = as_mark(result.contiguous_through);
+    const auto& result = std::get<store::StoreChunkResult>(batch.results[i]);
+    run->contiguous = as_mark(result.contiguous_through);
     if (result.status == store::ChunkStatus::conflict ||
         result.status == store::ChunkStatus::beyond_window) {
-      reject(key, &run, batch[i].chunk.sequence, result.reason);
+      reject(key, run, chunk.sequence, result.reason);
       continue;
     }
     const bool is_new = result.status == store::ChunkStatus::stored;
     context_.counters.add(is_new ? &CounterSnapshot::chunks_stored : &CounterSnapshot::chunks_duplicate);
-    if (is_new) stored[key].push_back(&batch[i].chunk);
+    if (is_new) stored[key].push_back(&chunk);
     if (std::find(touched.begin(), touched.end(), key) == touched.end()) touched.push_back(key);
   }
   // Durable now (the batch committed): acknowledge each run once, with its highest mark.
@@ -195,33 +269,6 @@ void RunService::flush_pending() {
   // idle tick's): one fsync per batch, not two.
   for (const auto& key : touched)
     if (std::find(unsaved_.begin(), unsaved_.end(), key) == unsaved_.end()) unsaved_.push_back(key);
-}
-
-// Stores the chunks in one transaction (one fsync); per chunk its result or the reason it was
-// refused (e.g. the run is closed). Empty when the batch could not be committed.
-std::vector<std::variant<store::StoreChunkResult, std::string>> RunService::store_batch(
-    const std::vector<PendingChunk>& batch) {
-  std::vector<std::variant<store::StoreChunkResult, std::string>> results(batch.size());
-  try {
-    context_.store.with([&](store::Store& s) {
-      s.batch([&](store::Store& b) {
-        save_unsaved(b);
-        for (std::size_t i = 0; i < batch.size(); ++i) {
-          try {
-            results[i] = b.store_chunk(batch[i].chunk);
-          } catch (const InputError& e) {  // rolled back alone; the others stay
-            results[i] = std::string(e.what());
-          }
-        }
-      });
-    });
-  } catch (const store::StoreError& e) {
-    context_.counters.add(&CounterSnapshot::store_errors, batch.size());
-    spdlog::error("{} chunks not stored ({}#{}..): {}", batch.size(), label(batch.front().key),
-                  batch.front().chunk.sequence, e.what());
-    return {};
-  }
-  return results;
 }
 
 std::vector<ingest::Chunk> RunService::read_chunks(const store::RunKey& key, std::uint64_t from,
@@ -236,14 +283,20 @@ std::vector<ingest::Chunk> RunService::read_chunks(const store::RunKey& key, std
 
 // The next chunk to fold: from the chunks in hand when there, else read from the store with
 // the ones after it (replay after a restart, chunks that were stored ahead of a gap).
-std::vector<ingest::Chunk> RunService::next_chunks(const store::RunKey& key, const RunState& run,
-                                                   const std::vector<const ingest::Chunk*>& in_hand) {
+// The next chunks to fold: the one in hand when there (no copy), else read from the store with
+// the ones after it (replay after a restart, chunks that were stored ahead of a gap); `read`
+// keeps those read.
+std::vector<const ingest::Chunk*> RunService::next_chunks(
+    const store::RunKey& key, const RunState& run, const std::vector<const ingest::Chunk*>& in_hand,
+    std::vector<ingest::Chunk>& read) {
   const std::uint64_t next = run.processor.next_sequence();
   for (const ingest::Chunk* chunk : in_hand)
-    if (chunk->sequence == next) return {*chunk};
-  auto batch = read_chunks(key, next, std::min<std::uint64_t>(next + kReplayBatch - 1, static_cast<std::uint64_t>(run.contiguous)));
-  context_.counters.add(&CounterSnapshot::chunks_replayed, batch.size());
-  return batch;
+    if (chunk->sequence == next) return {chunk};
+  read = read_chunks(key, next, std::min<std::uint64_t>(next + kReplayBatch - 1, static_cast<std::uint64_t>(run.contiguous)));
+  context_.counters.add(&CounterSnapshot::chunks_replayed, read.size());
+  std::vector<const ingest::Chunk*> chunks;
+  for (const auto& chunk : read) chunks.push_back(&chunk);
+  return chunks;
 }
 
 // Folds next_sequence()..contiguous in order; the folded mark and a due checkpoint are kept in
@@ -252,14 +305,15 @@ void RunService::fold_ready(const store::RunKey& key, RunState& run,
                             const std::vector<const ingest::Chunk*>& in_hand) {
   if (!run.halted.empty() || run.processor.finished()) return;
   const std::uint64_t first = run.processor.next_sequence();
+  std::vector<ingest::Chunk> read;
   while (run.contiguous >= 0 && run.processor.next_sequence() <= static_cast<std::uint64_t>(run.contiguous)) {
-    for (const auto& chunk : next_chunks(key, run, in_hand)) {
+    for (const ingest::Chunk* chunk : next_chunks(key, run, in_hand, read)) {
       try {
-        run.processor.push(chunk);
+        run.processor.push(*chunk);
       } catch (const InputError& e) {
         run.halted = std::string("folding halted: ") + e.what();
         spdlog::error("run {}: {}", label(key), run.halted);
-        run.rejections.push_back({chunk.sequence, run.halted});
+        run.rejections.push_back({chunk->sequence, run.halted});
         break;
       }
       context_.counters.add(&CounterSnapshot::chunks_folded);
@@ -289,40 +343,46 @@ void RunService::take_checkpoint(const store::RunKey& key, RunState& run) {
 // checkpoint after a rebuild from #0), the run goes on without it. A folded mark that is not
 // saved is harmless too: opening the store resets the marks to the checkpoints.
 void RunService::save_folds(const std::vector<store::RunKey>& keys) {
+  const auto folds = take_unsaved(keys);
   try {
     context_.store.with([&](store::Store& s) {
-      s.batch([&](store::Store& b) {
-        for (const auto& key : keys)
-          if (RunState* run = find(key)) save_fold(b, key, *run);
-      });
+      s.batch([&](store::Store& b) { write_folds(b, folds, context_.counters); });
     });
   } catch (const std::exception& e) {
     spdlog::error("folded marks and checkpoints of {} runs not saved: {}", keys.size(), e.what());
   }
 }
 
-// Inside a batch: the marks and checkpoints flush_pending left for later. Should the batch
-// not commit, they are lost, which only lengthens a replay after a restart.
-void RunService::save_unsaved(store::Store& s) {
-  for (const auto& key : std::exchange(unsaved_, {}))
-    if (RunState* run = find(key)) save_fold(s, key, *run);
+// What the runs have not saved yet, taken out of them (to be written by whichever
+// transaction takes them; should it not commit, they are lost, which only lengthens a replay).
+std::vector<RunService::SavedFold> RunService::take_unsaved(const std::vector<store::RunKey>& keys) {
+  std::vector<SavedFold> folds;
+  for (const auto& key : keys)
+    if (RunState* run = find(key))
+      folds.push_back({key, std::exchange(run->unsaved_checkpoints, {}),
+                       std::exchange(run->unsaved_fold, std::nullopt)});
+  return folds;
 }
 
-void RunService::save_fold(store::Store& s, const store::RunKey& key, RunState& run) {
-  for (const auto& checkpoint : std::exchange(run.unsaved_checkpoints, {})) {
-    try {
-      s.save_checkpoint(key, checkpoint.through, checkpoint.state);
-      context_.counters.add(&CounterSnapshot::checkpoints);
-      record_history(s, key, checkpoint.tables);
-    } catch (const InputError& e) {
-      spdlog::error("run {}: checkpoint through #{} not saved: {}", label(key), checkpoint.through, e.what());
+// Inside a transaction, on whichever thread runs it: touches no run, only the store.
+void RunService::write_folds(store::Store& s, const std::vector<SavedFold>& folds,
+                             ServerCounters& counters) {
+  for (const auto& fold : folds) {
+    for (const auto& checkpoint : fold.checkpoints) {
+      try {
+        s.save_checkpoint(fold.key, checkpoint.through, checkpoint.state);
+        counters.add(&CounterSnapshot::checkpoints);
+        record_history(s, fold.key, checkpoint.tables);
+      } catch (const InputError& e) {
+        spdlog::error("run {}: checkpoint through #{} not saved: {}", label(fold.key),
+                      checkpoint.through, e.what());
+      }
     }
-  }
-  if (const auto mark = std::exchange(run.unsaved_fold, std::nullopt)) {
+    if (!fold.mark) continue;
     try {
-      s.mark_folded(key, *mark);
+      s.mark_folded(fold.key, *fold.mark);
     } catch (const InputError& e) {
-      spdlog::error("run {}: folded mark #{} not saved: {}", label(key), *mark, e.what());
+      spdlog::error("run {}: folded mark #{} not saved: {}", label(fold.key), *fold.mark, e.what());
     }
   }
 }
@@ -384,12 +444,8 @@ void RunService::settle() {
 }
 
 void RunService::publish_due(std::chrono::steady_clock::time_point now) {
-  // Under load the marks and checkpoints ride with the next batch's commit; only an idle tick
-  // (nothing stored now) saves them on their own. Saving them after every batch cost a second
-  // fsync per batch, which the worker waited for before folding on.
-  const bool idle = pending_.empty();
-  flush_pending();
-  if (idle && !unsaved_.empty()) save_folds(std::exchange(unsaved_, {}));
+  submit_pending();
+  collect(false);
   // Only the changed runs are visited (a worker of 1000 vehicles ticks after every batch).
   std::vector<std::string> due;  // dirty_ is ordered by vehicle: a vehicle's runs are adjacent
   for (auto it = dirty_.begin(); it != dirty_.end();) {
@@ -404,6 +460,9 @@ void RunService::publish_due(std::chrono::steady_clock::time_point now) {
     ++it;
   }
   for (const auto& vehicle : due) publish_pending(vehicle);
+  // Under load the marks and checkpoints ride with the next batch of chunks; only an idle
+  // worker sends them on their own (after publishing: an estimate never waits for them).
+  if (pending_.empty() && in_flight_.empty() && !unsaved_.empty()) submit(pending_);
 }
 
 void RunService::record_history(const store::RunKey& key, const EstimateTables& tables) {

@@ -51,6 +51,10 @@ Server::Impl::Impl(ServerOptions opts)
     dds::check(dds_waitset_attach(waitset.get(), conditions.back().get(), 0), "dds_waitset_attach");
   }
   dds::check(dds_waitset_attach(waitset.get(), stop_guard.get(), 0), "dds_waitset_attach");
+  for (std::size_t k = 0; k < services.size(); ++k)
+    services[k]->set_waker([this, k] {
+      pool.post_unbounded(k, [this, k] { services[k]->collect_committed(); });
+    });
   resume_open_runs();
   spdlog::info("dynid-server: store {}, domain {}, {} workers, shard {}, checkpoint every {}",
                options.store_path, options.domain, pool.size(), options.shard.to_string(),
@@ -59,6 +63,14 @@ Server::Impl::Impl(ServerOptions opts)
 
 Server::Impl::~Impl() {
   pool.stop();  // finish what is queued while the services and writers still exist
+  for (auto& service : services) {  // and what is at the committer (acks, folds, marks)
+    try {
+      service->settle();
+    } catch (const std::exception& e) {
+      spdlog::error("stopping: {}", e.what());
+    }
+  }
+  committer.stop();  // nothing calls back into the pool or the services after this
   spdlog::info("dynid-server stopped; counters {}", counters.snapshot().to_json());
 }
 

@@ -65,7 +65,8 @@ struct Server::Impl {
   SharedStore store;
   dds::Participant participant;
   RevisionClock revisions;
-  ServerContext context{options, store, counters, participant, revisions};
+  Committer committer{store};  // before the services: stopped after the workers are done
+  ServerContext context{options, store, committer, counters, participant, revisions};
   dds::Reader<dynid_wire_RunAnnouncement> announcements;
   dds::Reader<dynid_wire_Chunk> chunks;
   dds::Reader<dynid_wire_Request> requests;

@@ -25,10 +25,16 @@ std::size_t WorkerPool::worker_of(std::string_view vehicle) const {
   return static_cast<std::size_t>((h >> 32 ^ h * 0x9e3779b97f4a7c15ULL) % queues_.size());
 }
 
-void WorkerPool::post(std::size_t worker, Task task) {
+void WorkerPool::post(std::size_t worker, Task task) { enqueue(worker, std::move(task), true); }
+
+void WorkerPool::post_unbounded(std::size_t worker, Task task) {
+  enqueue(worker, std::move(task), false);
+}
+
+void WorkerPool::enqueue(std::size_t worker, Task task, bool bounded) {
   Queue& q = *queues_.at(worker);
   std::unique_lock lock(q.mutex);
-  q.changed.wait(lock, [&] { return q.tasks.size() < max_queue_ || q.stopping; });
+  if (bounded) q.changed.wait(lock, [&] { return q.tasks.size() < max_queue_ || q.stopping; });
   if (q.stopping) return;
   q.tasks.push_back(std::move(task));
   q.changed.notify_all();

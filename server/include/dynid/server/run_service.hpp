@@ -4,17 +4,21 @@
 // run-level requests. One per worker; only that worker's thread calls it, so it needs no lock
 // of its own (the store is shared through SharedStore).
 //
-// Chunk path, with group commit: receive_chunk validates the chunk against the run's
-// announcement and queues it; flush_pending(), at the end of the worker's batch of tasks
-// (publish_due, the worker's tick), before any other call (so a request or announcement sees
-// every chunk received before it), and every kMaxBatch chunks, then:
-//   store the queued chunks in one transaction (Store::batch: durable with one fsync)
+// Chunk path, with group commit, pipelined: receive_chunk validates the chunk against the
+// run's announcement and queues it; at the end of the worker's batch of tasks (publish_due,
+// the worker's tick) and every kMaxBatch chunks the queue goes to the Committer
+// (committer.hpp), which stores it with the other worker's in one transaction (one fsync)
+// while this worker goes on; once committed, the committer wakes the worker
+// (collect_committed) and, in submission order:
 //   -> publish one ChunkAck per run (highest contiguous stored, recent rejections with reasons)
 //   -> fold every stored contiguous chunk not yet folded, in sequence order (a chunk stored
 //      ahead of a gap is folded when the gap closes)
 //   -> the folded marks, and a checkpoint every `checkpoint_every` folded chunks of a run (the
 //      state taken right after that chunk, with its estimate history entry), are saved in the next
-//      batch's transaction, or on the next tick when no chunk came: one fsync per batch
+//      batch's transaction, or as a batch of their own when the worker is idle: one fsync per
+//      batch
+// Before any other call (an announcement, a request, a resume) flush_pending() waits for every
+// batch, so it sees every chunk received before it.
 //   -> the run's estimates are published at most every `publish_interval` (publish_due).
 //      The Estimate instance is (vehicle, model), shared by the vehicle's runs and pools, and
 //      readers keep its latest sample. So a vehicle's changed runs are published together, the
@@ -37,11 +41,13 @@
 // folding ("halted", with the reason, logged and in the ack); its chunks stay in the store for
 // a reprocess.
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
@@ -52,6 +58,7 @@
 #include "dynid/dds/participant.hpp"
 #include "dynid/ingest/run_processor.hpp"
 #include "dynid/ls/fleet.hpp"
+#include "dynid/server/committer.hpp"
 #include "dynid/server/counters.hpp"
 #include "dynid/server/estimate_tables.hpp"
 #include "dynid/server/options.hpp"
@@ -71,6 +78,7 @@ class NotFound : public InputError {
 struct ServerContext {
   const ServerOptions& options;
   SharedStore& store;
+  Committer& committer;  // the store's writes of the chunk path
   ServerCounters& counters;
   const dds::Participant& participant;
   RevisionClock& revisions;
@@ -90,18 +98,24 @@ class RunService {
   explicit RunService(ServerContext& context) : context_(context) {}
 
   void announce(const ingest::RunAnnouncement& announcement);
-  void receive_chunk(const ingest::Chunk& chunk);
+  void receive_chunk(std::shared_ptr<const ingest::Chunk> chunk);
   /// A chunk sample that could not even be read (from_wire failed): reported to its sender
   /// when its vehicle and run ids are readable.
   void reject_unreadable(const std::string& vehicle, const std::string& run,
                          std::uint64_t sequence, const std::string& reason);
   void resume(const store::RunKey& key);
-  /// The worker's tick: stores, acknowledges and folds the queued chunks (flush_pending); when
-  /// there were none (idle), saves the folded marks and checkpoints still unsaved; then
-  /// publishes the estimates of runs that changed and whose interval has passed.
+  /// The worker's tick: hands the queued chunks to the committer, acknowledges and folds the
+  /// batches already committed, publishes the estimates of runs that changed and whose
+  /// interval has passed; idle, hands the unsaved folded marks and checkpoints to the committer.
   void publish_due(std::chrono::steady_clock::time_point now);
-  /// Stores, acknowledges and folds the chunks receive_chunk queued (see above).
+  /// Acknowledges and folds the batches the committer has committed (what its wake-up runs).
+  void collect_committed();
+  /// Stores, acknowledges and folds the chunks receive_chunk queued and waits for every batch
+  /// in flight (see above).
   void flush_pending();
+  /// How the committer wakes this service's worker after a commit; it must not block (the
+  /// server posts collect_committed() to the worker's queue). Set before the first chunk.
+  void set_waker(std::function<void()> wake) { wake_ = std::move(wake); }
   /// flush_pending(), then saves the folded marks and checkpoints still unsaved: the store's
   /// ledger is then up to date (before a request reads it, and on every tick).
   void settle();
@@ -145,7 +159,24 @@ class RunService {
   };
   struct PendingChunk {
     store::RunKey key;
-    ingest::Chunk chunk;
+    std::shared_ptr<const ingest::Chunk> chunk;  // as the dispatcher decoded it: no copy
+  };
+  /// A run's marks and checkpoints taken out of it, for a transaction on any thread.
+  struct SavedFold {
+    store::RunKey key;
+    std::vector<UnsavedCheckpoint> checkpoints;
+    std::optional<std::uint64_t> mark;
+  };
+  /// A batch at the committer: written there, read by the worker only once `done`.
+  struct InFlight {
+    std::vector<PendingChunk> chunks;
+    std::vector<SavedFold> folds;
+    std::vector<std::variant<store::StoreChunkResult, std::string>> results;
+    std::mutex mutex;
+    std::condition_variable finished;
+    bool done = false;
+    bool committed = false;
+    std::string error;  // why not, when not committed
   };
 
   RunState* find(const store::RunKey& key);
@@ -157,12 +188,17 @@ class RunService {
               const std::string& reason);
   void publish_ack(const store::RunKey& key, const RunState* run,
                    const std::vector<dds::ChunkRejection>& extra = {});
-  std::vector<std::variant<store::StoreChunkResult, std::string>> store_batch(
-      const std::vector<PendingChunk>& batch);
+  void submit_pending();
+  void submit(std::vector<PendingChunk>& chunks);
+  /// Applies the committed batches in order; with `wait`, waits for every one in flight.
+  void collect(bool wait);
+  bool collect_one(bool wait);
+  void apply(const InFlight& batch);
   void fold_ready(const store::RunKey& key, RunState& run,
                   const std::vector<const ingest::Chunk*>& in_hand);
-  std::vector<ingest::Chunk> next_chunks(const store::RunKey& key, const RunState& run,
-                                         const std::vector<const ingest::Chunk*>& in_hand);
+  std::vector<const ingest::Chunk*> next_chunks(const store::RunKey& key, const RunState& run,
+                                                const std::vector<const ingest::Chunk*>& in_hand,
+                                                std::vector<ingest::Chunk>& read);
   std::vector<ingest::Chunk> read_chunks(const store::RunKey& key, std::uint64_t from,
                                          std::uint64_t to);
   /// Every stored chunk of the run up to the highest contiguous one, in order, to `sink`.
@@ -170,8 +206,9 @@ class RunService {
                      const std::function<void(const ingest::Chunk&)>& sink);
   void take_checkpoint(const store::RunKey& key, RunState& run);
   void save_folds(const std::vector<store::RunKey>& keys);
-  void save_fold(store::Store& s, const store::RunKey& key, RunState& run);
-  void save_unsaved(store::Store& s);
+  std::vector<SavedFold> take_unsaved(const std::vector<store::RunKey>& keys);
+  static void write_folds(store::Store& s, const std::vector<SavedFold>& folds,
+                          ServerCounters& counters);
   void publish(const store::RunKey& key, RunState& run);
   void publish_tables(const std::string& vehicle, EstimateTables tables);
   /// Publishes now every run of `vehicle` whose estimates changed since their last publication,
@@ -180,12 +217,15 @@ class RunService {
   /// The run's estimates changed since their last publication (dirty_).
   void mark_changed(const store::RunKey& key, RunState& run);
   void record_history(const store::RunKey& key, const EstimateTables& tables);
-  void record_history(store::Store& s, const store::RunKey& key, const EstimateTables& tables);
+  static void record_history(store::Store& s, const store::RunKey& key,
+                             const EstimateTables& tables);
   std::string latest_run(const std::string& vehicle);
 
   ServerContext& context_;
   std::map<store::RunKey, std::unique_ptr<RunState>> runs_;
-  std::vector<PendingChunk> pending_;  // received, validated, not yet stored
+  std::vector<PendingChunk> pending_;  // received, validated, not yet at the committer
+  std::deque<std::shared_ptr<InFlight>> in_flight_;  // at the committer, oldest first
+  std::function<void()> wake_;
   std::uint64_t changes_ = 0;          // RunState::changed counter
   std::set<store::RunKey> dirty_;      // runs whose estimates changed since their publication
   std::vector<store::RunKey> unsaved_;  // runs whose folded mark or checkpoint is not saved

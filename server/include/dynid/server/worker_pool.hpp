@@ -7,6 +7,8 @@
 // Contract:
 // - post() enqueues; when the worker's queue holds `max_queue` tasks it blocks until there is
 //   room (back-pressure to the DDS reader, whose keep-all limits then hold the cars back).
+//   post_unbounded() never blocks: for a completion the worker may itself be waiting for
+//   (the committer's wake-up), which a full queue must not hold back.
 // - A worker takes every task queued at once, runs them in order, then calls tick(worker)
 //   once; idle, it calls tick at least every `tick_period`. The server stores the chunks of
 //   such a batch in one transaction and publishes throttled estimates there, so a busy worker
@@ -41,6 +43,7 @@ class WorkerPool {
   /// The worker a vehicle is pinned to.
   std::size_t worker_of(std::string_view vehicle) const;
   void post(std::size_t worker, Task task);
+  void post_unbounded(std::size_t worker, Task task);
   void stop();
 
  private:
@@ -51,6 +54,7 @@ class WorkerPool {
     bool stopping = false;
   };
   void run(std::size_t worker);
+  void enqueue(std::size_t worker, Task task, bool bounded);
   static void run_task(std::size_t worker, const Task& task);  // logs and drops a throw
 
   std::size_t max_queue_;
