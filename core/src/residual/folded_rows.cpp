@@ -109,12 +109,15 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   std::vector<double> row(static_cast<std::size_t>(width + 1));
   for (std::size_t s = 0; s < run.size(); ++s) {
     const ingest::PreprocessedSegment& seg = run[s];
-    const std::vector<model::GroupRows> built = model.rows(seg.channels, model_effects);
+    std::vector<Eigen::Index> kept;  // rows are built at the decimation grid's samples only
+    for (Eigen::Index i = 0; i < seg.channels.samples(); ++i)
+      if (ingest::on_decimation_grid(seg, i, odmf)) kept.push_back(i);
+    if (kept.empty()) continue;
+    const std::vector<model::GroupRows> built = model.rows_at(seg.channels, kept, model_effects);
     for (std::size_t g = 0; g < built.size(); ++g) {
       const model::GroupRows& gr = built[g];
       for (std::size_t i = 0; i < gr.samples.size(); ++i) {
         const Eigen::Index sample = gr.samples[i];
-        if (!ingest::on_decimation_grid(seg, sample, odmf)) continue;
         std::fill(row.begin(), row.end(), 0.0);
         for (Eigen::Index j = 0; j < model_width; ++j)
           row[static_cast<std::size_t>(j)] = gr.W(static_cast<Eigen::Index>(i), j);
