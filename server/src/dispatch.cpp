@@ -77,7 +77,7 @@ void Server::Impl::dispatch_chunk(const dynid_wire_Chunk& sample) {
   const std::size_t worker = pool.worker_of(*vehicle);
   RunService* service = services[worker].get();
   if (chunk) {
-    pool.post(worker, [service, chunk = std::move(chunk)]() mutable { service->receive_chunk(std::move(chunk)); });
+    pool.post(worker, [service, chunk = std::move(chunk)] { service->receive_chunk(chunk); });
   } else {
     pool.post(worker, [service, v = *vehicle, r = *run, s = sample.sequence_number, error] {
       service->reject_unreadable(v, r, s, error);

@@ -143,7 +143,7 @@ void RunService::reject_unreadable(const std::string& vehicle, const std::string
   reject(key, find(key), sequence, reason);
 }
 
-void RunService::receive_chunk(std::shared_ptr<const ingest::Chunk> chunk) {
+void RunService::receive_chunk(const std::shared_ptr<const ingest::Chunk>& chunk) {
   const store::RunKey key{chunk->vehicle, chunk->run};
   RunState* run = find(key);
   if (!run) {
@@ -153,12 +153,12 @@ void RunService::receive_chunk(std::shared_ptr<const ingest::Chunk> chunk) {
       return reject(key, nullptr, chunk->sequence, "unknown run " + label(key) + " (never announced)");
     }
   }
-  try {
-    ingest::validate_chunk(*chunk, run->processor.announcement(), context_.options.store.limits);
+  try {  // once: the store and the processor take the ValidatedChunk as checked
+    pending_.push_back({key, ingest::ValidatedChunk::validate(chunk, run->processor.announcement(),
+                                                              context_.options.store.limits)});
   } catch (const InputError& e) {
     return reject(key, run, chunk->sequence, e.what());
   }
-  pending_.push_back({key, std::move(chunk)});
   if (pending_.size() >= kMaxBatch) submit_pending();
 }
 
@@ -186,7 +186,7 @@ void RunService::submit(std::vector<PendingChunk>& chunks) {
         write_folds(s, batch->folds, counters);
         for (std::size_t i = 0; i < batch->chunks.size(); ++i) {
           try {
-            batch->results[i] = s.store_chunk(*batch->chunks[i].chunk);
+            batch->results[i] = s.store_chunk(batch->chunks[i].chunk);
           } catch (const InputError& e) {  // rolled back alone; the others stay
             batch->results[i] = std::string(e.what());
           }
@@ -229,7 +229,7 @@ bool RunService::collect_one(bool wait) {
     }
     context_.counters.add(&CounterSnapshot::store_errors, batch->chunks.size());
     spdlog::error("{} chunks not stored ({}#{}..): {}", batch->chunks.size(),
-                  label(batch->chunks.front().key), batch->chunks.front().chunk->sequence,
+                  label(batch->chunks.front().key), batch->chunks.front().chunk.chunk().sequence,
                   batch->error);
     return true;
   }
@@ -240,10 +240,10 @@ bool RunService::collect_one(bool wait) {
 // A committed batch: every chunk's outcome into its run, one ack per run, then the folds.
 void RunService::apply(const InFlight& batch) {
   std::vector<store::RunKey> touched;  // runs with news, in arrival order
-  std::map<store::RunKey, std::vector<const ingest::Chunk*>> stored;
+  std::map<store::RunKey, std::vector<const ingest::ValidatedChunk*>> stored;
   for (std::size_t i = 0; i < batch.chunks.size(); ++i) {
     const store::RunKey& key = batch.chunks[i].key;
-    const ingest::Chunk& chunk = *batch.chunks[i].chunk;
+    const ingest::Chunk& chunk = batch.chunks[i].chunk.chunk();
     RunState* run = find(key);  // loaded by receive_chunk; only its own failed load unloads it
     if (!run) continue;         // stored all the same: a later load replays it
     if (const auto* refused = std::get_if<std::string>(&batch.results[i])) {
@@ -259,7 +259,7 @@ void RunService::apply(const InFlight& batch) {
     }
     const bool is_new = result.status == store::ChunkStatus::stored;
     context_.counters.add(is_new ? &CounterSnapshot::chunks_stored : &CounterSnapshot::chunks_duplicate);
-    if (is_new) stored[key].push_back(&chunk);
+    if (is_new) stored[key].push_back(&batch.chunks[i].chunk);
     if (std::find(touched.begin(), touched.end(), key) == touched.end()) touched.push_back(key);
   }
   // Durable now (the batch committed): acknowledge each run once, with its highest mark.
@@ -283,47 +283,56 @@ std::vector<ingest::Chunk> RunService::read_chunks(const store::RunKey& key, std
 
 // The next chunk to fold: from the chunks in hand when there, else read from the store with
 // the ones after it (replay after a restart, chunks that were stored ahead of a gap).
-// The next chunks to fold: the one in hand when there (no copy), else read from the store with
-// the ones after it (replay after a restart, chunks that were stored ahead of a gap); `read`
-// keeps those read.
-std::vector<const ingest::Chunk*> RunService::next_chunks(
-    const store::RunKey& key, const RunState& run, const std::vector<const ingest::Chunk*>& in_hand,
-    std::vector<ingest::Chunk>& read) {
+// The next chunks to fold, read from the store (replay after a restart, chunks that were stored
+// ahead of a gap): the next one and up to kReplayBatch - 1 after it.
+std::vector<ingest::Chunk> RunService::read_next(const store::RunKey& key, const RunState& run) {
   const std::uint64_t next = run.processor.next_sequence();
-  for (const ingest::Chunk* chunk : in_hand)
-    if (chunk->sequence == next) return {chunk};
-  read = read_chunks(key, next, std::min<std::uint64_t>(next + kReplayBatch - 1, static_cast<std::uint64_t>(run.contiguous)));
-  context_.counters.add(&CounterSnapshot::chunks_replayed, read.size());
-  std::vector<const ingest::Chunk*> chunks;
-  for (const auto& chunk : read) chunks.push_back(&chunk);
+  auto chunks = read_chunks(key, next, std::min<std::uint64_t>(next + kReplayBatch - 1, static_cast<std::uint64_t>(run.contiguous)));
+  context_.counters.add(&CounterSnapshot::chunks_replayed, chunks.size());
   return chunks;
 }
 
-// Folds next_sequence()..contiguous in order; the folded mark and a due checkpoint are kept in
-// the run for save_folds().
+// Folds next_sequence()..contiguous in order, from the chunks in hand (validated on arrival:
+// not validated again, not copied) when there, else from the store; the folded mark and a due
+// checkpoint are kept in the run for save_folds().
 void RunService::fold_ready(const store::RunKey& key, RunState& run,
-                            const std::vector<const ingest::Chunk*>& in_hand) {
+                            const std::vector<const ingest::ValidatedChunk*>& in_hand) {
   if (!run.halted.empty() || run.processor.finished()) return;
   const std::uint64_t first = run.processor.next_sequence();
-  std::vector<ingest::Chunk> read;
-  while (run.contiguous >= 0 && run.processor.next_sequence() <= static_cast<std::uint64_t>(run.contiguous)) {
-    for (const ingest::Chunk* chunk : next_chunks(key, run, in_hand, read)) {
-      try {
-        run.processor.push(*chunk);
-      } catch (const InputError& e) {
-        run.halted = std::string("folding halted: ") + e.what();
-        spdlog::error("run {}: {}", label(key), run.halted);
-        run.rejections.push_back({chunk->sequence, run.halted});
-        break;
-      }
-      context_.counters.add(&CounterSnapshot::chunks_folded);
-      mark_changed(key, run);
-      if (++run.since_checkpoint >= context_.options.checkpoint_every) take_checkpoint(key, run);
+  while (run.halted.empty() && run.contiguous >= 0 &&
+         run.processor.next_sequence() <= static_cast<std::uint64_t>(run.contiguous)) {
+    const std::uint64_t next = run.processor.next_sequence();
+    const auto hand = std::find_if(in_hand.begin(), in_hand.end(),
+                                   [&](const auto* c) { return c->chunk().sequence == next; });
+    if (hand != in_hand.end()) {
+      fold_one(key, run, next, [&] { run.processor.push(**hand); });
+      continue;
     }
-    if (!run.halted.empty()) break;
+    const auto chunks = read_next(key, run);
+    if (chunks.empty()) break;  // the store returned nothing it counts as stored: never spin
+    for (const auto& chunk : chunks)
+      if (!fold_one(key, run, chunk.sequence, [&] { run.processor.push(chunk); })) break;
   }
   const std::uint64_t after = run.processor.next_sequence();
   if (after > first) run.unsaved_fold = after - 1;
+}
+
+// One chunk into the run's processor (push); false when the processor refused it: the run is
+// then halted with the reason.
+bool RunService::fold_one(const store::RunKey& key, RunState& run, std::uint64_t sequence,
+                          const std::function<void()>& push) {
+  try {
+    push();
+  } catch (const InputError& e) {
+    run.halted = std::string("folding halted: ") + e.what();
+    spdlog::error("run {}: {}", label(key), run.halted);
+    run.rejections.push_back({sequence, run.halted});
+    return false;
+  }
+  context_.counters.add(&CounterSnapshot::chunks_folded);
+  mark_changed(key, run);
+  if (++run.since_checkpoint >= context_.options.checkpoint_every) take_checkpoint(key, run);
+  return true;
 }
 
 // The state right after this chunk, saved with the folded mark (every one of them: each is an

@@ -56,10 +56,22 @@ void Store::Impl::insert(const detail::RunRow& run, const ingest::Chunk& chunk,
 }
 
 StoreChunkResult Store::store_chunk(const ingest::Chunk& chunk) {
-  Impl& s = *impl_;
+  const detail::RunRow& run = impl_->run({chunk.vehicle, chunk.run});
+  ingest::validate_chunk(chunk, run.announcement, impl_->options.limits);
+  return impl_->store_valid(run, chunk);
+}
+
+StoreChunkResult Store::store_chunk(const ingest::ValidatedChunk& validated) {
+  const ingest::Chunk& chunk = validated.chunk();
+  const detail::RunRow& run = impl_->run({chunk.vehicle, chunk.run});
+  if (!validated.validated_for(run.announcement, impl_->options.limits))
+    ingest::validate_chunk(chunk, run.announcement, impl_->options.limits);
+  return impl_->store_valid(run, chunk);
+}
+
+StoreChunkResult Store::Impl::store_valid(const detail::RunRow& run, const ingest::Chunk& chunk) {
+  Impl& s = *this;
   const RunKey key{chunk.vehicle, chunk.run};
-  const detail::RunRow& run = s.run(key);
-  ingest::validate_chunk(chunk, run.announcement, s.options.limits);
   const std::string bytes = ingest::encode_chunk(chunk);
   const std::string label = name_of(key, chunk.sequence);
 

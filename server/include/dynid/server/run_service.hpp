@@ -57,6 +57,7 @@
 #include "dynid/dds/chunk_receipt.hpp"
 #include "dynid/dds/participant.hpp"
 #include "dynid/ingest/run_processor.hpp"
+#include "dynid/ingest/validated_chunk.hpp"
 #include "dynid/ls/fleet.hpp"
 #include "dynid/server/committer.hpp"
 #include "dynid/server/counters.hpp"
@@ -98,7 +99,7 @@ class RunService {
   explicit RunService(ServerContext& context) : context_(context) {}
 
   void announce(const ingest::RunAnnouncement& announcement);
-  void receive_chunk(std::shared_ptr<const ingest::Chunk> chunk);
+  void receive_chunk(const std::shared_ptr<const ingest::Chunk>& chunk);
   /// A chunk sample that could not even be read (from_wire failed): reported to its sender
   /// when its vehicle and run ids are readable.
   void reject_unreadable(const std::string& vehicle, const std::string& run,
@@ -159,7 +160,7 @@ class RunService {
   };
   struct PendingChunk {
     store::RunKey key;
-    std::shared_ptr<const ingest::Chunk> chunk;  // as the dispatcher decoded it: no copy
+    ingest::ValidatedChunk chunk;  // the dispatcher's decoded chunk, shared (no copy), checked
   };
   /// A run's marks and checkpoints taken out of it, for a transaction on any thread.
   struct SavedFold {
@@ -195,10 +196,10 @@ class RunService {
   bool collect_one(bool wait);
   void apply(const InFlight& batch);
   void fold_ready(const store::RunKey& key, RunState& run,
-                  const std::vector<const ingest::Chunk*>& in_hand);
-  std::vector<const ingest::Chunk*> next_chunks(const store::RunKey& key, const RunState& run,
-                                                const std::vector<const ingest::Chunk*>& in_hand,
-                                                std::vector<ingest::Chunk>& read);
+                  const std::vector<const ingest::ValidatedChunk*>& in_hand);
+  std::vector<ingest::Chunk> read_next(const store::RunKey& key, const RunState& run);
+  bool fold_one(const store::RunKey& key, RunState& run, std::uint64_t sequence,
+                const std::function<void()>& push);
   std::vector<ingest::Chunk> read_chunks(const store::RunKey& key, std::uint64_t from,
                                          std::uint64_t to);
   /// Every stored chunk of the run up to the highest contiguous one, in order, to `sink`.

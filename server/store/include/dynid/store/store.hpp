@@ -59,6 +59,7 @@
 
 #include "dynid/ingest/chunk.hpp"
 #include "dynid/ingest/run_announcement.hpp"
+#include "dynid/ingest/validated_chunk.hpp"
 #include "dynid/store/chunk_stream.hpp"
 #include "dynid/store/errors.hpp"
 
@@ -143,6 +144,10 @@ class Store {
   ingest::RunAnnouncement announcement(const RunKey& run);
   /// Validates against the run's announcement, then stores durably (see Ordering above).
   StoreChunkResult store_chunk(const ingest::Chunk& chunk);
+  /// The same for a chunk validated on arrival: validate_chunk is not run again when the chunk
+  /// was checked for this run's announcement under this store's limits (validated_for), and is
+  /// otherwise.
+  StoreChunkResult store_chunk(const ingest::ValidatedChunk& chunk);
   std::optional<std::uint64_t> highest_contiguous(const RunKey& run);
   std::optional<std::uint64_t> folded_through(const RunKey& run);
   /// Chunks from..to (inclusive) in order; `to` must not exceed highest_contiguous().
