@@ -281,8 +281,6 @@ std::vector<ingest::Chunk> RunService::read_chunks(const store::RunKey& key, std
   });
 }
 
-// The next chunk to fold: from the chunks in hand when there, else read from the store with
-// the ones after it (replay after a restart, chunks that were stored ahead of a gap).
 // The next chunks to fold, read from the store (replay after a restart, chunks that were stored
 // ahead of a gap): the next one and up to kReplayBatch - 1 after it.
 std::vector<ingest::Chunk> RunService::read_next(const store::RunKey& key, const RunState& run) {
