@@ -35,6 +35,16 @@ bool same(double a, double b, double relative) {
   return std::abs(a - b) <= relative * std::max(std::abs(a), std::abs(b)) || a == b;
 }
 
+// True when every expected model is among `published` with the expected row count.
+bool rows_match(const std::vector<Reference>& expected,
+                const std::map<std::string, dds::EstimateTable>& published) {
+  for (const auto& r : expected) {
+    const auto it = published.find(r.model);
+    if (it == published.end() || it->second.rows != r.rows) return false;
+  }
+  return !expected.empty();
+}
+
 }  // namespace
 
 TempDir::TempDir() {
@@ -244,22 +254,11 @@ bool TestCar::deliver(const std::vector<ingest::Chunk>& chunks, std::size_t from
 EstimateWatcher::EstimateWatcher(const std::string& vehicle)
     : vehicle_(vehicle), reader_(participant(), {dds::vehicle_partition(vehicle)}) {}
 
-bool EstimateWatcher::wait(
-    const std::function<bool(const std::map<std::string, dds::EstimateTable>&)>& done,
-    std::chrono::milliseconds patience) {
-  const auto deadline = std::chrono::steady_clock::now() + patience;
-  for (;;) {
-    if (done(latest_)) return true;
-    if (std::chrono::steady_clock::now() >= deadline) return false;
-    take(50ms);
-  }
-}
-
 bool EstimateWatcher::wait_for(const std::vector<Reference>& expected, const std::string& source,
                                std::chrono::milliseconds patience) {
   const auto deadline = std::chrono::steady_clock::now() + patience;
   for (;;) {
-    if (rows_match(expected, latest(source), source)) return true;
+    if (rows_match(expected, latest(source))) return true;
     if (std::chrono::steady_clock::now() >= deadline) return false;
     take(50ms);
   }
@@ -285,8 +284,8 @@ void EstimateWatcher::take(std::chrono::milliseconds timeout) {
   for (auto& sample : reader_.wait_take(timeout)) {
     auto table = dds::from_wire(sample.data);
     if (table.vehicle != vehicle_) ++foreign_;
-    by_source_[table.source][table.model] = table;
-    latest_[table.model] = std::move(table);
+    const std::string source = table.source, model = table.model;
+    by_source_[source][model] = std::move(table);
   }
 }
 
@@ -334,15 +333,6 @@ std::vector<Reference> references(const std::vector<ingest::ModelEstimate>& esti
   for (const auto& e : estimates)
     if (e.estimate) out.push_back(reference_of(e.model, e.parameters, *e.estimate));
   return out;
-}
-
-bool rows_match(const std::vector<Reference>& expected,
-                const std::map<std::string, dds::EstimateTable>& published, const std::string& source) {
-  for (const auto& r : expected) {
-    const auto it = published.find(r.model);
-    if (it == published.end() || it->second.source != source || it->second.rows != r.rows) return false;
-  }
-  return !expected.empty();
 }
 
 void expect_equal(const Reference& expected, const dds::EstimateTable& published, double relative) {

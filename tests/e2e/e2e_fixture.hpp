@@ -122,20 +122,15 @@ class TestCar {
 
 struct Reference;
 
-/// Estimates of one vehicle as published, checked by the vehicle id. Kept per source as well
-/// as overall: a run's throttled publication may arrive after a pool's, so a test waiting for
-/// one source must not have it replaced by another.
+/// Estimates of one vehicle as published, checked by the vehicle id, the latest table per source
+/// and model: a run's throttled publication may arrive after a pool's, so a test waiting for one
+/// source must not have it replaced by another.
 class EstimateWatcher {
  public:
   explicit EstimateWatcher(const std::string& vehicle);
-  /// Waits until the latest table of every model satisfies `done`; false at the deadline.
-  bool wait(const std::function<bool(const std::map<std::string, dds::EstimateTable>&)>& done,
-            std::chrono::milliseconds patience = kPatience);
   /// Waits until every expected model is published from `source` with the expected row count.
   bool wait_for(const std::vector<Reference>& expected, const std::string& source,
                 std::chrono::milliseconds patience = kPatience);
-  /// The latest table per model, whatever its source.
-  const std::map<std::string, dds::EstimateTable>& latest() const { return latest_; }
   /// The latest table per model from `source` (empty when none came).
   const std::map<std::string, dds::EstimateTable>& latest(const std::string& source) const;
   std::size_t foreign() const { return foreign_; }  ///< tables of another vehicle (crosstalk)
@@ -147,7 +142,6 @@ class EstimateWatcher {
 
   std::string vehicle_;
   dds::Reader<dynid_wire_Estimate> reader_;
-  std::map<std::string, dds::EstimateTable> latest_;
   std::map<std::string, std::map<std::string, dds::EstimateTable>> by_source_;
   std::size_t foreign_ = 0;
 };
@@ -173,10 +167,6 @@ std::vector<Reference> references(const std::vector<ingest::ModelEstimate>& esti
 Reference reference_of(const std::string& model, const std::vector<model::ParameterInfo>& parameters,
                        const ls::WeightedEstimate& estimate);
 
-/// True when every reference model is published with the same row count.
-bool rows_match(const std::vector<Reference>& expected,
-                const std::map<std::string, dds::EstimateTable>& published,
-                const std::string& source);
 /// Values, standard deviations and sigma agree to `relative` (NaN matches NaN).
 void expect_equal(const Reference& expected, const dds::EstimateTable& published,
                   double relative = 1e-12);

@@ -22,8 +22,7 @@ TEST(E2eStreaming, PublishedEstimateEqualsOfflineProcessor) {
   ASSERT_EQ(streaming.size(), 3u) << "every model of the test run has an estimate";
   ASSERT_TRUE(watcher.wait_for(streaming, "run-1"))
       << "no estimate with the offline row counts was published: " << [&] {
-           std::string s;
-           for (const auto& [m, t] : watcher.latest()) s += m + " " + t.source + " rows " + std::to_string(t.rows) + "; ";
+           std::string s = "seen " + watcher.seen() + " ";
            for (const auto& r : streaming) s += "expected " + r.model + " " + std::to_string(r.rows) + "; ";
            return s;
          }();
