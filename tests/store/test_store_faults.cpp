@@ -298,6 +298,56 @@ TEST(StoreCorruption, FilesThatAreNotOurStoreAreRefusedNamingTheFile) {
   }
 }
 
+// ---- schema migration ------------------------------------------------------------------
+
+// Rebuilds the chunks table in version 1's layout (WITHOUT ROWID, bytes inline in the key's
+// b-tree) and marks the file version 1, as a store written before the migration existed.
+void downgrade_to_version_1(const std::string& path) {
+  raw_sql(path,
+          "BEGIN;"
+          "CREATE TABLE chunks_v1 (run_id INTEGER NOT NULL REFERENCES runs(id),"
+          " sequence INTEGER NOT NULL CHECK (sequence >= 0), first_sample_index INTEGER NOT NULL,"
+          " rows INTEGER NOT NULL, bytes BLOB NOT NULL, crc INTEGER NOT NULL,"
+          " stored_ns INTEGER NOT NULL, PRIMARY KEY (run_id, sequence)) WITHOUT ROWID;"
+          "INSERT INTO chunks_v1 SELECT run_id, sequence, first_sample_index, rows, bytes, crc,"
+          " stored_ns FROM chunks;"
+          "DROP TABLE chunks; ALTER TABLE chunks_v1 RENAME TO chunks;"
+          "DELETE FROM schema_version WHERE version > 1; COMMIT;");
+}
+
+TEST(StoreSchema, VersionOneFileIsMigratedKeepingEveryChunkAndItsLedger) {
+  test::TempDir dir;
+  const std::string path = dir.file("store.db");
+  {
+    Store store(path);
+    store.add_run(announcement("proto-17", "run-1"));
+    for (std::uint64_t s : {0, 1, 2, 4}) store.store_chunk(chunk("proto-17", "run-1", s));
+  }
+  downgrade_to_version_1(path);
+  ASSERT_EQ(raw_int(path, "SELECT max(version) FROM schema_version"), 1);
+  ASSERT_EQ(raw_int(path, "SELECT count(*) FROM sqlite_schema WHERE name = 'chunks' AND "
+                          "sql LIKE '%WITHOUT ROWID%'"),
+            1);
+
+  Store store(path);
+  EXPECT_EQ(raw_int(path, "SELECT max(version) FROM schema_version"), 2);
+  EXPECT_EQ(raw_int(path, "SELECT count(*) FROM sqlite_schema WHERE name = 'chunks' AND "
+                          "sql LIKE '%WITHOUT ROWID%'"),
+            0);
+  EXPECT_EQ(store.highest_contiguous(kRun), 2u);
+  // The chunk stored ahead of the gap is still there: filling the gap reaches it.
+  EXPECT_EQ(store.store_chunk(chunk("proto-17", "run-1", 3)).status, ChunkStatus::stored);
+  EXPECT_EQ(store.highest_contiguous(kRun), 4u);
+  EXPECT_EQ(store.store_chunk(chunk("proto-17", "run-1", 1)).status, ChunkStatus::duplicate);
+  EXPECT_EQ(store.store_chunk(chunk("proto-17", "run-1", 1, 10, 1)).status, ChunkStatus::conflict);
+  auto stream = store.chunks(kRun, 0, 4);
+  for (std::uint64_t s = 0; s <= 4; ++s) {
+    const auto c = stream.next();
+    ASSERT_TRUE(c.has_value());
+    EXPECT_TRUE(test::same(*c, chunk("proto-17", "run-1", s))) << "chunk " << s;
+  }
+}
+
 // ---- full disk ---------------------------------------------------------------------------
 
 TEST(StoreFullDisk, FullFileIsAClearErrorAndStoresNoPartOfTheChunk) {

@@ -70,10 +70,34 @@ CREATE INDEX estimates_by_vehicle_model ON estimates (vehicle_id, model, time_ns
 INSERT INTO schema_version (version) VALUES (1);
 )sql";
 
+// Version 2: chunks become a rowid table with a separate (run_id, sequence) index, the bytes
+// last. In version 1's WITHOUT ROWID table every key comparison of a b-tree search read the
+// whole row, a ~24 KB blob through its overflow pages, so each existence check of the ingest
+// path copied ~100 KB; the index holds only the keys.
+constexpr const char* kVersion2 = R"sql(
+CREATE TABLE chunks_v2 (
+  id                 INTEGER PRIMARY KEY,
+  run_id             INTEGER NOT NULL REFERENCES runs(id),
+  sequence           INTEGER NOT NULL CHECK (sequence >= 0),
+  first_sample_index INTEGER NOT NULL,
+  rows               INTEGER NOT NULL,
+  crc                INTEGER NOT NULL,
+  stored_ns          INTEGER NOT NULL,
+  bytes              BLOB NOT NULL,
+  UNIQUE (run_id, sequence)
+);
+INSERT INTO chunks_v2 (run_id, sequence, first_sample_index, rows, crc, stored_ns, bytes)
+  SELECT run_id, sequence, first_sample_index, rows, crc, stored_ns, bytes FROM chunks
+  ORDER BY run_id, sequence;
+DROP TABLE chunks;
+ALTER TABLE chunks_v2 RENAME TO chunks;
+INSERT INTO schema_version (version) VALUES (2);
+)sql";
+
 // migrations[v] takes a file from version v to v + 1 (v = 0 is the empty file). A later
 // version appends its script here and bumps kSchemaVersion; the script also updates
 // schema_version.
-constexpr std::array<const char*, kSchemaVersion> kMigrations = {kVersion1};
+constexpr std::array<const char*, kSchemaVersion> kMigrations = {kVersion1, kVersion2};
 
 std::int64_t pragma_int(Database& db, const char* sql) {
   Statement statement(db, sql);
