@@ -91,17 +91,25 @@ std::uint32_t Chunk::compute_checksum() const {
   return detail::crc32_of(encode_body(*this).bytes());
 }
 
-void validate_chunk(const Chunk& chunk, const RunAnnouncement& run, const ChunkLimits& limits) {
+std::string validate_and_encode(const Chunk& chunk, const RunAnnouncement& run,
+                                const ChunkLimits& limits) {
   if (chunk.vehicle != run.vehicle)
     reject(chunk, "vehicle '" + chunk.vehicle + "' but the run is of '" + run.vehicle + "'");
   if (chunk.run != run.run)
     reject(chunk, "run '" + chunk.run + "' but the run is '" + run.run + "'");
-  check_shape(chunk, run, limits);
-  const std::uint32_t expected = chunk.compute_checksum();
+  check_shape(chunk, run, limits);  // first: the encoding below is sized by the shape
+  detail::ByteWriter encoded = encode_body(chunk);
+  const std::uint32_t expected = detail::crc32_of(encoded.bytes());
   if (chunk.checksum != expected)
     reject(chunk, "checksum " + std::to_string(chunk.checksum) + " does not match the content (" +
                       std::to_string(expected) + "): corrupted");
   check_values(chunk, run, limits);
+  encoded.put<std::uint32_t>(chunk.checksum);
+  return encoded.take();
+}
+
+void validate_chunk(const Chunk& chunk, const RunAnnouncement& run, const ChunkLimits& limits) {
+  validate_and_encode(chunk, run, limits);
 }
 
 std::string encode_chunk(const Chunk& chunk) {

@@ -4,15 +4,16 @@
 
 namespace dynid::ingest {
 
-ValidatedChunk::ValidatedChunk(std::shared_ptr<const Chunk> chunk, const ChunkLimits& limits)
-    : chunk_(std::move(chunk)), limits_(limits) {}
+ValidatedChunk::ValidatedChunk(std::shared_ptr<const Chunk> chunk, const ChunkLimits& limits,
+                               std::string encoded)
+    : chunk_(std::move(chunk)), limits_(limits), encoded_(std::move(encoded)) {}
 
 ValidatedChunk ValidatedChunk::validate(std::shared_ptr<const Chunk> chunk,
                                         const RunAnnouncement& run, const ChunkLimits& limits) {
   if (!chunk)
     throw InputError("chunk of " + run.vehicle + "/" + run.run + ": null (no chunk to validate)");
-  validate_chunk(*chunk, run, limits);
-  return ValidatedChunk(std::move(chunk), limits);
+  std::string encoded = validate_and_encode(*chunk, run, limits);
+  return ValidatedChunk(std::move(chunk), limits, std::move(encoded));
 }
 
 ValidatedChunk ValidatedChunk::validate(Chunk chunk, const RunAnnouncement& run,

@@ -57,22 +57,24 @@ void Store::Impl::insert(const detail::RunRow& run, const ingest::Chunk& chunk,
 
 StoreChunkResult Store::store_chunk(const ingest::Chunk& chunk) {
   const detail::RunRow& run = impl_->run({chunk.vehicle, chunk.run});
-  ingest::validate_chunk(chunk, run.announcement, impl_->options.limits);
-  return impl_->store_valid(run, chunk);
+  return impl_->store_valid(run, chunk,
+                            ingest::validate_and_encode(chunk, run.announcement, impl_->options.limits));
 }
 
 StoreChunkResult Store::store_chunk(const ingest::ValidatedChunk& validated) {
   const ingest::Chunk& chunk = validated.chunk();
   const detail::RunRow& run = impl_->run({chunk.vehicle, chunk.run});
-  if (!validated.validated_for(run.announcement, impl_->options.limits))
-    ingest::validate_chunk(chunk, run.announcement, impl_->options.limits);
-  return impl_->store_valid(run, chunk);
+  if (!validated.validated_for(run.announcement, impl_->options.limits)) {
+    return impl_->store_valid(
+        run, chunk, ingest::validate_and_encode(chunk, run.announcement, impl_->options.limits));
+  }
+  return impl_->store_valid(run, chunk, validated.encoded());
 }
 
-StoreChunkResult Store::Impl::store_valid(const detail::RunRow& run, const ingest::Chunk& chunk) {
+StoreChunkResult Store::Impl::store_valid(const detail::RunRow& run, const ingest::Chunk& chunk,
+                                          const std::string& bytes) {
   Impl& s = *this;
   const RunKey key{chunk.vehicle, chunk.run};
-  const std::string bytes = ingest::encode_chunk(chunk);
   const std::string label = name_of(key, chunk.sequence);
 
   detail::Transaction transaction(s.db);  // rolls back on every early return and throw

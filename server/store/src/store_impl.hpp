@@ -105,8 +105,9 @@ struct Store::Impl {
   std::int64_t advance_contiguous(std::int64_t run_id, std::int64_t from);
   std::optional<std::string> stored_bytes(std::int64_t run_id, std::uint64_t sequence);
   void insert(const detail::RunRow& run, const ingest::Chunk& chunk, const std::string& bytes);
-  /// store_chunk after validation (Ordering in store.hpp).
-  StoreChunkResult store_valid(const detail::RunRow& run, const ingest::Chunk& chunk);
+  /// store_chunk after validation; `bytes` is encode_chunk(chunk) (Ordering in store.hpp).
+  StoreChunkResult store_valid(const detail::RunRow& run, const ingest::Chunk& chunk,
+                               const std::string& bytes);
 };
 
 }  // namespace dynid::store

@@ -58,6 +58,11 @@ struct Chunk {
 /// is the CRC-32 of everything before it, so compute_checksum() is defined by this layout.
 void validate_chunk(const Chunk& chunk, const RunAnnouncement& run, const ChunkLimits& limits = {});
 
+/// validate_chunk, returning encode_chunk(chunk): checking the checksum encodes the chunk, so a
+/// caller that also stores the bytes (the server) gets them without encoding it a second time.
+std::string validate_and_encode(const Chunk& chunk, const RunAnnouncement& run,
+                                const ChunkLimits& limits = {});
+
 /// Exact binary encoding of a chunk (for the store and the spool) and its inverse, which
 /// throws InputError on truncated or corrupted input (the checksum is verified).
 std::string encode_chunk(const Chunk& chunk);

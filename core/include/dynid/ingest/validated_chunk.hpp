@@ -11,9 +11,13 @@
 // validates again on any difference, so a chunk checked for another run or under laxer limits
 // is never taken as valid.
 //
+// It keeps the chunk's encoding (encode_chunk) too: validation computes it to check the
+// checksum, and the store writes exactly those bytes.
+//
 // Caveat: the chunk is shared, not copied; modifying it through another (non-const) pointer
 // after validation voids the check. The overload taking a Chunk by value owns its copy.
 #include <memory>
+#include <string>
 
 #include "dynid/ingest/chunk.hpp"
 #include "dynid/ingest/run_announcement.hpp"
@@ -32,15 +36,19 @@ class ValidatedChunk {
   const Chunk& chunk() const { return *chunk_; }
   const std::shared_ptr<const Chunk>& shared() const { return chunk_; }
   const ChunkLimits& limits() const { return limits_; }
+  /// encode_chunk(chunk()), computed during validation.
+  const std::string& encoded() const { return encoded_; }
 
   /// True when validate_chunk(chunk(), run, limits) needs not run again: the chunk's ids and
   /// channel count are the run's and it was checked under these very limits.
   bool validated_for(const RunAnnouncement& run, const ChunkLimits& limits) const;
 
  private:
-  ValidatedChunk(std::shared_ptr<const Chunk> chunk, const ChunkLimits& limits);
+  ValidatedChunk(std::shared_ptr<const Chunk> chunk, const ChunkLimits& limits,
+                 std::string encoded);
   std::shared_ptr<const Chunk> chunk_;
   ChunkLimits limits_;
+  std::string encoded_;
 };
 
 }  // namespace dynid::ingest
