@@ -1,7 +1,8 @@
 // ValidatedChunk and RunProcessor::push(const ValidatedChunk&): a chunk validated for the run
 // under the processor's limits is pushed without a second validation and gives the same bits as
 // push(Chunk); one validated for another run, or under other limits, is validated again (and
-// rejected if it fails, changing nothing); a bad chunk cannot become a ValidatedChunk.
+// rejected if it fails, changing nothing); a bad chunk cannot become a ValidatedChunk; the
+// encoding it keeps is encode_chunk's.
 #include "dynid/ingest/validated_chunk.hpp"
 
 #include "dynid/ingest/run_processor.hpp"
@@ -29,6 +30,15 @@ TEST(ValidatedChunk, PushedAsValidatedGivesTheSameBitsAsAPlainPush) {
   validated.finish();
   EXPECT_EQ(validated.checkpoint(), plain.checkpoint());
   EXPECT_GT(validated.counters().final_samples, 0u);
+}
+
+TEST(ValidatedChunk, KeepsTheEncodingItChecked) {
+  const TestRun run = test::make_run(500);
+  const Chunk c = test::cut(run, 0, 0, 100);
+  const std::string expected = encode_chunk(c);
+  EXPECT_EQ(validate_and_encode(c, run.announcement), expected);
+  EXPECT_EQ(ValidatedChunk::validate(c, run.announcement).encoded(), expected);
+  EXPECT_EQ(decode_chunk(expected).checksum, c.checksum);
 }
 
 TEST(ValidatedChunk, ABadChunkCannotBeMadeOne) {
