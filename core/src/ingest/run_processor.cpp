@@ -411,6 +411,22 @@ bool RunProcessor::finished() const {
 std::vector<std::pair<std::string, std::string>> RunProcessor::derived_channels() const {
   return impl_->derived;
 }
+std::vector<signal::HeldBuffer> RunProcessor::held_buffers() const {
+  const Impl& s = *impl_;
+  std::vector<signal::HeldBuffer> out;
+  s.segment->held_buffers("segment ", out);
+  if (s.scratch) s.scratch->held_buffers("rollback ", out);
+  for (const ModelRun& m : s.models) {
+    std::size_t bytes = 0;
+    for (std::size_t g = 0; m.groups && g < m.groups->size(); ++g) {
+      const ls::Accumulator::ExtendedMatrix& r = m.groups->group(g).augmented_r_extended();
+      bytes += static_cast<std::size_t>(r.size()) * sizeof(ls::Accumulator::Extended);
+    }
+    if (m.groups) out.push_back({m.spec.model + " accumulators", bytes, bytes});
+  }
+  return out;
+}
+
 const signal::Sos& RunProcessor::filter() const {
   return impl_->sos;
 }

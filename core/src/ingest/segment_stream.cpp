@@ -148,6 +148,20 @@ void SegmentStream::consume(Eigen::Index count) {
     window_.conservativeResize(usual, Eigen::NoChange);
 }
 
+void SegmentStream::held_buffers(const std::string& prefix,
+                                 std::vector<signal::HeldBuffer>& out) const {
+  for (signal::HeldBuffer& b : filter_.held_buffers()) {
+    b.name = prefix + b.name;
+    out.push_back(std::move(b));
+  }
+  if (derivative_) {
+    const Eigen::MatrixXd recent = derivative_->state().recent;
+    out.push_back(signal::held_buffer(prefix + "derivative recent", recent, recent.rows()));
+  }
+  out.push_back(signal::held_buffer(prefix + "pass-through FIFO", fifo_, fifo_rows_));
+  out.push_back(signal::held_buffer(prefix + "row window", window_, window_rows_));
+}
+
 void SegmentStream::save(ByteWriter& w) const {
   w.put_bool(active_);
   w.put<std::uint64_t>(start_);

@@ -12,11 +12,13 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "byte_codec.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/signal/derivative.hpp"
+#include "dynid/signal/held_buffer.hpp"
 #include "dynid/signal/streaming_zero_phase_filter.hpp"
 
 namespace dynid::ingest::detail {
@@ -70,6 +72,9 @@ class SegmentStream {
   ReadyRows ready(bool at_end) const;
   /// Marks the `count` rows of the last ready() built; drops rows no later row reaches.
   void consume(Eigen::Index count);
+
+  /// The buffers held between pushes (filter, derivative, FIFO, window), names prefixed.
+  void held_buffers(const std::string& prefix, std::vector<signal::HeldBuffer>& out) const;
 
   void save(ByteWriter& w) const;
   /// Throws InputError (via the reader or the signal classes) when the state does not fit.

@@ -368,6 +368,13 @@ StreamingZeroPhaseFilter::State StreamingZeroPhaseFilter::state() const {
           pending_.middleRows(pending_first_, pending_rows_)};
 }
 
+std::vector<HeldBuffer> StreamingZeroPhaseFilter::held_buffers() const {
+  return {held_buffer("filter head", head_, head_.rows()),
+          held_buffer("filter raw tail", raw_tail_, raw_tail_.rows()),
+          held_buffer("filter forward state", forward_state_, forward_state_.rows()),
+          held_buffer("filter pending", pending_, pending_rows_)};
+}
+
 void StreamingZeroPhaseFilter::check_state(const State& s) const {
   const auto fail = [](const std::string& why) {
     throw InputError("StreamingZeroPhaseFilter::restore: " + why);

@@ -56,6 +56,7 @@
 #include "dynid/ingest/validated_chunk.hpp"
 #include "dynid/ls/equation_groups.hpp"
 #include "dynid/model/model.hpp"
+#include "dynid/signal/held_buffer.hpp"
 #include "dynid/signal/sos.hpp"
 
 namespace dynid::ingest {
@@ -125,6 +126,10 @@ class RunProcessor {
   bool finished() const;
   /// Names and units of the derived channels made here (d_<name>), in column order.
   std::vector<std::pair<std::string, std::string>> derived_channels() const;
+  /// The buffers held between pushes, for memory accounting (allocated and held bytes): the
+  /// segment's ("segment ...") and the rollback copy's ("rollback ..."), then each run model's
+  /// accumulators ("<model> accumulators"). Small fixed members are not listed.
+  std::vector<signal::HeldBuffer> held_buffers() const;
   /// The low-pass applied (for reports and for reproducing the processing offline).
   const signal::Sos& filter() const;
 

@@ -27,6 +27,9 @@
 // Memory between calls: O((overlap + block) x channels), whatever the length of the signal.
 #include <Eigen/Core>
 
+#include <vector>
+
+#include "dynid/signal/held_buffer.hpp"
 #include "dynid/signal/sos.hpp"
 
 namespace dynid::signal {
@@ -85,6 +88,9 @@ class StreamingZeroPhaseFilter {
   // not yet released): at most delay() after any push().
   Eigen::Index buffered_samples() const { return head_.rows() + pending_rows_; }
   bool finished() const { return finished_; }
+  // The buffers held between calls (head, raw tail, forward state, pending), each with its
+  // allocated and held bytes: for memory accounting.
+  std::vector<HeldBuffer> held_buffers() const;
 
  private:
   void start_forward();
