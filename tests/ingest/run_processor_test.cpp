@@ -9,6 +9,7 @@
 #include "dynid/model/channel_set.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/signal/derivative.hpp"
+#include "dynid/signal/streaming_zero_phase_filter.hpp"
 #include "dynid/signal/zero_phase_filter.hpp"
 #include "ingest_test_support.hpp"
 
@@ -313,6 +314,64 @@ TEST(RunProcessor, ARejectedChunkChangesNoState) {
   EXPECT_THROW(p.finish(), InputError);
   EXPECT_THROW(p.push(test::cut(run, sizes.size(), 0, 1)), InputError);
   expect_bit_identical(p, processed(run, sizes));
+}
+
+// A model rejecting a row in the middle of a chunk, after the filter has moved on (and, in the
+// second case, after a gap ended the segment and a new one started in that chunk), leaves the
+// processor as it was: the run then goes on as if the bad chunk had never come.
+TEST(RunProcessor, AModelRejectingARowMidChunkChangesNoState) {
+  const TestRun run = test::make_run(3000);
+  ChunkLimits wide;
+  wide.max_abs_value = 1e300;  // lets through an engine speed whose square overflows
+  struct Case {
+    Eigen::Index first, count, spike;  // the bad chunk, and where its spike starts
+  };
+  for (const Case c : {Case{600, 600, 650}, Case{1400, 700, 1700}}) {
+    std::vector<Eigen::Index> sizes;  // chunks of 100 rows, but the bad one
+    for (Eigen::Index at = 0; at < run.samples.rows(); at += sizes.back())
+      sizes.push_back(at == c.first ? c.count : std::min<Eigen::Index>(100, run.samples.rows() - at));
+    const std::size_t bad = static_cast<std::size_t>(c.first / 100);
+    RunProcessor p(run.announcement, wide);
+    feed(p, run, sizes, 0, bad);
+    const std::string before = p.checkpoint();
+    Chunk spiked = test::cut(run, bad, c.first, c.count);
+    spiked.samples.col(3).segment(c.spike - c.first, 200).setConstant(1e200);
+    spiked.seal();
+    test::expect_input_error([&] { p.push(spiked); }, {"locked_driveline", "non-finite row"});
+    EXPECT_EQ(p.checkpoint(), before) << "bad chunk at " << c.first;
+    feed(p, run, sizes, bad);
+    p.finish();
+    RunProcessor whole(run.announcement, wide);
+    feed(whole, run, sizes);
+    whole.finish();
+    expect_bit_identical(p, whole);
+    EXPECT_EQ(p.checkpoint(), whole.checkpoint()) << "bad chunk at " << c.first;
+  }
+}
+
+// Between pushes the rollback copy holds rows the segment held (fewer than the filter's
+// overlap + block), no room for a chunk, and the segment's filter keeps the room of
+// StreamingZeroPhaseFilter::held_buffers, over any number of chunks and segments.
+TEST(RunProcessor, HeldBuffersStayBoundedOverManyChunks) {
+  const TestRun run = test::make_run(6000);  // with gaps: three segments
+  RunProcessor p(run.announcement);
+  const signal::StreamingZeroPhaseFilter f(p.filter(), 5,
+                                           run.announcement.preprocessing.filter_tolerance);
+  const std::size_t filtered_row = 5 * sizeof(double);  // all channels but the gear
+  const auto unit = static_cast<std::size_t>(f.overlap() + f.block());
+  Eigen::Index at = 0;
+  for (std::size_t k = 0; at + 10 <= run.samples.rows(); ++k, at += 10) {
+    p.push(test::cut(run, k, at, 10));
+    for (const signal::HeldBuffer& b : p.held_buffers()) {
+      if (b.name == "rollback filter pending") {
+        EXPECT_LE(b.allocated, (unit - 1) * filtered_row) << "after chunk " << k;
+      } else if (b.name == "rollback pass-through FIFO") {
+        EXPECT_LE(b.allocated, (unit - 1) * sizeof(double)) << "after chunk " << k;
+      } else if (b.name == "segment filter pending") {
+        EXPECT_LE(b.allocated, 2 * unit * filtered_row) << "after chunk " << k;
+      }
+    }
+  }
 }
 
 TEST(RunProcessor, ModelsWithoutTheirChannelsAreNotRunAndBadUnitsAreRejected) {

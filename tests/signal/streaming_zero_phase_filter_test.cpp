@@ -195,6 +195,41 @@ TEST(StreamingZeroPhaseFilter, TooShortSignalIsRejectedThenCanGrow) {
   EXPECT_LT((y - zero_phase_filter(sos, x)).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+std::size_t pending_allocated(const StreamingZeroPhaseFilter& f) {
+  for (const HeldBuffer& b : f.held_buffers())
+    if (b.name == "filter pending") return b.allocated;
+  ADD_FAILURE() << "no pending buffer listed";
+  return 0;
+}
+
+TEST(StreamingZeroPhaseFilter, PendingRoomStaysBoundedAndCopiesHaveNone) {
+  const Sos sos = butterworth_lowpass(5, 5.0, 100.0);
+  StreamingZeroPhaseFilter filter(sos, 3);
+  const Eigen::Index unit = filter.overlap() + filter.block();
+  const auto rows_of = [&](std::size_t bytes) {
+    return static_cast<Eigen::Index>(bytes / (3 * sizeof(double)));
+  };
+  const Eigen::MatrixXd x = test::test_signal(400 * unit, 3, 5u);
+  Eigen::Index in = 0;
+  for (const Eigen::Index m : random_sizes(unit, 6u)) {  // 500 chunks of at most `unit` rows
+    (void)filter.push(x.middleRows(in, m));
+    in += m;
+    if (in > filter.padlen()) {
+      EXPECT_EQ(rows_of(pending_allocated(filter)), 2 * unit);
+    }
+  }
+  const StreamingZeroPhaseFilter copy(filter);
+  EXPECT_EQ(rows_of(pending_allocated(copy)), filter.buffered_samples());
+  StreamingZeroPhaseFilter assigned(sos, 3);
+  assigned = filter;
+  EXPECT_EQ(rows_of(pending_allocated(assigned)), filter.buffered_samples());
+  for (const Eigen::Index m : {20 * unit, unit, 3 * unit, 2 * unit + 1}) {  // long chunks too
+    (void)filter.push(x.middleRows(in, m));
+    in += m;
+    EXPECT_LE(rows_of(pending_allocated(filter)), 4 * unit) << "after a chunk of " << m;
+  }
+}
+
 TEST(StreamingZeroPhaseFilter, RejectsBadSettings) {
   const Sos sos = butterworth_lowpass(2, 10.0, 100.0);
   EXPECT_THROW(StreamingZeroPhaseFilter(sos, 0), InputError);

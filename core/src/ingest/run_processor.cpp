@@ -91,8 +91,9 @@ struct RunProcessor::Impl {
   std::vector<ModelRun> models;
   model::RowReach reach;
   std::optional<detail::SegmentStream> segment;
-  // The rollback copy of `segment` a push works on (kept to reuse its buffers between chunks).
-  std::optional<detail::SegmentStream> scratch;
+  // `segment` as it was before the push in progress, its held rows only (no spare room): a
+  // rejected push copies it back. Kept between pushes to reuse its buffers.
+  std::optional<detail::SegmentStream> backup;
   RunCounters counters;
   std::uint64_t next_sequence = 0;
   std::uint64_t next_index = 0;
@@ -106,7 +107,9 @@ struct RunProcessor::Impl {
                std::vector<FoldJob>& jobs) const;
   void end_segment(detail::SegmentStream& seg, RunCounters& c, std::vector<FoldJob>& jobs) const;
   void fold(const std::vector<FoldJob>& jobs);
-  detail::SegmentStream& working_copy();
+  /// Runs step(*segment); when it throws, puts the segment back as it was (strong guarantee).
+  template <class Step>
+  void guarded(Step&& step);
   /// RunProcessor::push; `validated`: validate_chunk passed for this announcement and limits.
   void push(const Chunk& chunk, bool validated);
 };
@@ -237,12 +240,20 @@ void RunProcessor::Impl::fold(const std::vector<FoldJob>& jobs) {
       if (job.rows[g].W.rows() > 0) models[job.model].groups->fold(g, job.rows[g].W, job.rows[g].y);
 }
 
-detail::SegmentStream& RunProcessor::Impl::working_copy() {
-  if (scratch)
-    *scratch = *segment;
+template <class Step>
+void RunProcessor::Impl::guarded(Step&& step) {
+  // The segment is worked on in place and only its held rows are saved: a second full copy
+  // with its room for a chunk would double the run's memory.
+  if (backup)
+    *backup = *segment;
   else
-    scratch.emplace(*segment);
-  return *scratch;
+    backup.emplace(*segment);
+  try {
+    step(*segment);
+  } catch (...) {
+    *segment = *backup;  // copied back, not swapped: the working buffers keep their room
+    throw;
+  }
 }
 
 RunProcessor::RunProcessor(RunAnnouncement announcement, ChunkLimits limits)
@@ -271,27 +282,27 @@ void RunProcessor::Impl::push(const Chunk& chunk, bool validated) {
     throw InputError(where + "starts at sample " + std::to_string(chunk.first_sample_index) +
                      ", expected " + std::to_string(next_index) +
                      " (gaps are sent as invalid rows, not skipped)");
-  // Work on copies of the stream state: a model rejecting the data leaves everything unchanged.
-  detail::SegmentStream& seg = working_copy();
+  // Counters are updated on a copy: a model rejecting the data leaves everything unchanged.
   RunCounters c = counters;
-  std::vector<FoldJob> jobs;
   const Eigen::Index m = chunk.samples.rows();
-  for (Eigen::Index k = 0; k < m;) {
-    const std::uint8_t flag = chunk.valid[static_cast<std::size_t>(k)];
-    Eigen::Index e = k;
-    while (e < m && chunk.valid[static_cast<std::size_t>(e)] == flag) ++e;
-    if (flag == 1) {
-      if (!seg.active()) seg.start(chunk.first_sample_index + static_cast<std::uint64_t>(k));
-      seg.push(chunk.samples.middleRows(k, e - k));
-      collect(seg, false, c, jobs);
-    } else {
-      end_segment(seg, c, jobs);
-      c.invalid_samples += static_cast<std::uint64_t>(e - k);
+  guarded([&](detail::SegmentStream& seg) {
+    std::vector<FoldJob> jobs;
+    for (Eigen::Index k = 0; k < m;) {
+      const std::uint8_t flag = chunk.valid[static_cast<std::size_t>(k)];
+      Eigen::Index e = k;
+      while (e < m && chunk.valid[static_cast<std::size_t>(e)] == flag) ++e;
+      if (flag == 1) {
+        if (!seg.active()) seg.start(chunk.first_sample_index + static_cast<std::uint64_t>(k));
+        seg.push(chunk.samples.middleRows(k, e - k));
+        collect(seg, false, c, jobs);
+      } else {
+        end_segment(seg, c, jobs);
+        c.invalid_samples += static_cast<std::uint64_t>(e - k);
+      }
+      k = e;
     }
-    k = e;
-  }
-  fold(jobs);
-  std::swap(segment, scratch);
+    fold(jobs);
+  });
   counters = c;
   ++counters.chunks;
   counters.samples += static_cast<std::uint64_t>(m);
@@ -304,12 +315,12 @@ void RunProcessor::finish() {
   if (s.finished)
     throw InputError("run " + s.announcement.vehicle + "/" + s.announcement.run +
                      ": already finished");
-  detail::SegmentStream& seg = s.working_copy();
   RunCounters c = s.counters;
-  std::vector<FoldJob> jobs;
-  s.end_segment(seg, c, jobs);
-  s.fold(jobs);
-  std::swap(s.segment, s.scratch);
+  s.guarded([&](detail::SegmentStream& seg) {
+    std::vector<FoldJob> jobs;
+    s.end_segment(seg, c, jobs);
+    s.fold(jobs);
+  });
   s.counters = c;
   s.finished = true;
 }
@@ -415,7 +426,7 @@ std::vector<signal::HeldBuffer> RunProcessor::held_buffers() const {
   const Impl& s = *impl_;
   std::vector<signal::HeldBuffer> out;
   s.segment->held_buffers("segment ", out);
-  if (s.scratch) s.scratch->held_buffers("rollback ", out);
+  if (s.backup) s.backup->held_buffers("rollback ", out);
   for (const ModelRun& m : s.models) {
     std::size_t bytes = 0;
     for (std::size_t g = 0; m.groups && g < m.groups->size(); ++g) {

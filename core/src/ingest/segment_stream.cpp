@@ -16,9 +16,10 @@ Eigen::MatrixXd gather(const Eigen::Ref<const Eigen::MatrixXd>& x,
   return out;
 }
 
-// dst's first `rows` rows = src's, keeping dst's buffer when it is large enough.
+// dst's first `rows` rows = src's, keeping dst's buffer when it is large enough; a new buffer
+// has room for these rows only (a rollback copy needs no room to grow).
 void copy_rows(Eigen::MatrixXd& dst, const Eigen::MatrixXd& src, Eigen::Index rows) {
-  if (dst.cols() != src.cols() || dst.rows() < rows) dst.resize(src.rows(), src.cols());
+  if (dst.cols() != src.cols() || dst.rows() < rows) dst.resize(rows, src.cols());
   dst.topRows(rows) = src.topRows(rows);
 }
 
@@ -40,8 +41,9 @@ SegmentStream::SegmentStream(const signal::Sos& sos, Layout layout, double sampl
       filter_(sos, static_cast<Eigen::Index>(layout_.filtered.size()), tolerance) {
   if (!layout_.derived_from.empty())
     derivative_.emplace(static_cast<Eigen::Index>(layout_.derived_from.size()), sample_period);
-  fifo_.resize(2 * (filter_.delay() + 1), static_cast<Eigen::Index>(layout_.unfiltered.size()));
-  window_.resize(usual_window(), layout_.width());
+  // No rows yet: a run that has not sent a sample costs no buffer (they grow on first use).
+  fifo_.resize(0, static_cast<Eigen::Index>(layout_.unfiltered.size()));
+  window_.resize(0, layout_.width());
 }
 
 SegmentStream::SegmentStream(const SegmentStream& other)
@@ -122,7 +124,8 @@ void SegmentStream::append_final(const Eigen::MatrixXd& filtered) {
 
 void SegmentStream::reserve_window(Eigen::Index rows) {
   if (window_.rows() < rows)
-    window_.conservativeResize(std::max(2 * window_.rows(), rows), Eigen::NoChange);
+    window_.conservativeResize(std::max({2 * window_.rows(), rows, usual_window()}),
+                               Eigen::NoChange);
 }
 
 ReadyRows SegmentStream::ready(bool at_end) const {
@@ -138,14 +141,15 @@ void SegmentStream::consume(Eigen::Index count) {
   built_ += count;
   const Eigen::Index drop = std::max<Eigen::Index>(0, built_ - reach_.back - window_first_);
   if (drop == 0) return;
+  const Eigen::Index used = window_rows_;
   const Eigen::Index keep = window_rows_ - drop;
   window_.topRows(keep) = window_.middleRows(drop, keep).eval();
   window_first_ += drop;
   window_rows_ = keep;
-  // A long chunk grew the window: give the memory back so idle runs stay small.
-  const Eigen::Index usual = usual_window();
-  if (window_.rows() > 4 * usual && keep <= usual)
-    window_.conservativeResize(usual, Eigen::NoChange);
+  // A chunk much longer than this one grew the window: give the memory back so idle runs stay
+  // small (room for what this one used stays: chunks of one size do not reallocate).
+  const Eigen::Index usual = std::max(usual_window(), used);
+  if (window_.rows() > 4 * usual) window_.conservativeResize(usual, Eigen::NoChange);
 }
 
 void SegmentStream::held_buffers(const std::string& prefix,
@@ -228,7 +232,9 @@ void SegmentStream::load(ByteReader& r) {
 }
 
 Eigen::Index SegmentStream::usual_window() const {
-  return 2 * (filter_.delay() + 1) + reach_.back + reach_.ahead;
+  // Between pushes the window holds the context only; a push adds what the filter releases (a
+  // block at least; more for a longer chunk, the window then grows to it).
+  return filter_.block() + reach_.back + reach_.ahead;
 }
 
 }  // namespace dynid::ingest::detail

@@ -83,7 +83,7 @@ class SegmentStream {
  private:
   void append_final(const Eigen::MatrixXd& filtered);
   void reserve_window(Eigen::Index rows);
-  // Rows the window holds in steady state: a filter block, the context and the look-ahead.
+  // Rows the window is given first: a filter block, the context and the look-ahead.
   Eigen::Index usual_window() const;
 
   Layout layout_;

@@ -206,8 +206,7 @@ StreamingZeroPhaseFilter& StreamingZeroPhaseFilter::operator=(const StreamingZer
 
 void StreamingZeroPhaseFilter::copy_pending(const StreamingZeroPhaseFilter& other) {
   const Eigen::Index rows = other.pending_rows_;
-  if (pending_.cols() != channels_ || pending_.rows() < rows)
-    pending_.resize(std::max(rows, other.pending_.rows()), channels_);
+  if (pending_.cols() != channels_ || pending_.rows() < rows) pending_.resize(rows, channels_);
   pending_.topRows(rows) = other.pending_.middleRows(other.pending_first_, rows);
   pending_first_ = 0;
   pending_rows_ = rows;
@@ -297,6 +296,13 @@ void StreamingZeroPhaseFilter::start_forward() {
   forward_into_pending(head);
 }
 
+Eigen::Index StreamingZeroPhaseFilter::usual_room() const {
+  // Held rows stay below overlap + block after a push: twice that leaves a chunk of up to
+  // overlap + block rows room, and a move of the held rows about once per overlap + block
+  // released samples (a memmove of < 1/4 of what the release's sweeps read).
+  return 2 * (overlap_ + block_);
+}
+
 void StreamingZeroPhaseFilter::make_room(Eigen::Index m) {
   // Room for m more rows after the held ones: move the held rows to the top (one block move per
   // channel, seldom: only when the rows released since the last move leave too little room),
@@ -309,7 +315,7 @@ void StreamingZeroPhaseFilter::make_room(Eigen::Index m) {
     }
     pending_first_ = 0;
   }
-  const Eigen::Index usual = 4 * (overlap_ + block_);
+  const Eigen::Index usual = usual_room();
   if (pending_.rows() < pending_rows_ + m)
     pending_.conservativeResize(std::max({2 * pending_.rows(), pending_rows_ + m, usual}),
                                 Eigen::NoChange);
@@ -354,7 +360,7 @@ Eigen::MatrixXd StreamingZeroPhaseFilter::release(Eigen::Index blocks) {
   pending_rows_ -= count;
   n_out_ += count;
   // A long chunk grew the buffer: give the memory back so idle runs stay small.
-  const Eigen::Index usual = 4 * (overlap_ + block_);
+  const Eigen::Index usual = usual_room();
   if (pending_.rows() > 2 * usual && pending_rows_ <= usual) {
     pending_.topRows(pending_rows_) = pending_.middleRows(pending_first_, pending_rows_).eval();
     pending_first_ = 0;

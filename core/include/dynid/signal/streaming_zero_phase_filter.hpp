@@ -89,7 +89,9 @@ class StreamingZeroPhaseFilter {
   Eigen::Index buffered_samples() const { return head_.rows() + pending_rows_; }
   bool finished() const { return finished_; }
   // The buffers held between calls (head, raw tail, forward state, pending), each with its
-  // allocated and held bytes: for memory accounting.
+  // allocated and held bytes: for memory accounting. The pending buffer's room: 2 (overlap() +
+  // block()) rows while chunks have at most overlap() + block() rows, at most twice that after
+  // any push (a longer chunk grows it, its release gives the room back); a copy has none.
   std::vector<HeldBuffer> held_buffers() const;
 
  private:
@@ -100,6 +102,8 @@ class StreamingZeroPhaseFilter {
   void keep_raw_tail(const Eigen::MatrixXd& chunk);
   void copy_pending(const StreamingZeroPhaseFilter& other);
   void make_room(Eigen::Index rows);
+  // Rows the pending buffer is given when it grows, and shrunk back to after a long chunk.
+  Eigen::Index usual_room() const;
 
   Sos sos_;
   Eigen::VectorXd unit_state_;  // steady state of the cascade for a unit constant input
