@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -228,6 +229,62 @@ TEST(StreamingZeroPhaseFilter, PendingRoomStaysBoundedAndCopiesHaveNone) {
     in += m;
     EXPECT_LE(rows_of(pending_allocated(filter)), 4 * unit) << "after a chunk of " << m;
   }
+}
+
+// Whatever follows mark() (short and long chunks, finish(), a new signal), rollback() returns to
+// the marked state to the bit, and the signal then continues as if nothing had come.
+TEST(StreamingZeroPhaseFilter, RollbackReturnsToTheMark) {
+  const Sos sos = butterworth_lowpass(4, 6.0, 100.0);
+  StreamingZeroPhaseFilter filter(sos, 2);
+  const Eigen::Index unit = filter.overlap() + filter.block();
+  const Eigen::MatrixXd x = test::test_signal(40 * unit, 2, 8u);
+  const Eigen::MatrixXd junk = test::test_signal(30 * unit, 2, 9u);
+  StreamingZeroPhaseFilter whole(sos, 2);
+  const Eigen::MatrixXd expected = stream(whole, x, {unit / 2});
+  const auto same_state = [](const StreamingZeroPhaseFilter& a, const StreamingZeroPhaseFilter& b) {
+    const StreamingZeroPhaseFilter::State s = a.state();
+    const StreamingZeroPhaseFilter::State t = b.state();
+    return s.samples_in == t.samples_in && s.samples_out == t.samples_out &&
+           s.finished == t.finished && s.head == t.head && s.raw_tail == t.raw_tail &&
+           s.forward_state == t.forward_state && s.pending == t.pending;
+  };
+  Eigen::MatrixXd y(x.rows(), 2);
+  Eigen::Index in = 0;
+  Eigen::Index out = 0;
+  for (int round = 0; in < x.rows(); ++round) {
+    const StreamingZeroPhaseFilter before(filter);
+    filter.mark();
+    switch (round % 4) {  // what a rejected push may have done
+      case 0:
+        (void)filter.push(junk.topRows(unit / 3));
+        break;
+      case 1:
+        (void)filter.push(junk.topRows(7 * unit));  // grows and moves the buffer
+        (void)filter.push(junk.middleRows(7 * unit, unit));
+        break;
+      case 2:
+        if (filter.samples_in() > filter.padlen()) (void)filter.finish();
+        filter.reset();
+        (void)filter.push(junk.topRows(3 * unit));
+        break;
+      default:
+        (void)filter.push(junk.topRows(20 * unit));
+        filter.reset();
+    }
+    filter.rollback();
+    EXPECT_TRUE(same_state(filter, before)) << "round " << round;
+    const Eigen::Index m = std::min(unit / 2, x.rows() - in);
+    filter.mark();
+    const Eigen::MatrixXd got = filter.push(x.middleRows(in, m));
+    filter.commit();
+    in += m;
+    y.middleRows(out, got.rows()) = got;
+    out += got.rows();
+  }
+  const Eigen::MatrixXd tail = filter.finish();
+  y.bottomRows(tail.rows()) = tail;
+  EXPECT_EQ((y - expected).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_THROW(filter.rollback(), std::logic_error);
 }
 
 TEST(StreamingZeroPhaseFilter, RejectsBadSettings) {

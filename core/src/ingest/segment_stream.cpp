@@ -17,7 +17,7 @@ Eigen::MatrixXd gather(const Eigen::Ref<const Eigen::MatrixXd>& x,
 }
 
 // dst's first `rows` rows = src's, keeping dst's buffer when it is large enough; a new buffer
-// has room for these rows only (a rollback copy needs no room to grow).
+// has room for these rows only (an undo copy needs no room to grow).
 void copy_rows(Eigen::MatrixXd& dst, const Eigen::MatrixXd& src, Eigen::Index rows) {
   if (dst.cols() != src.cols() || dst.rows() < rows) dst.resize(rows, src.cols());
   dst.topRows(rows) = src.topRows(rows);
@@ -40,116 +40,124 @@ SegmentStream::SegmentStream(const signal::Sos& sos, Layout layout, double sampl
       reach_{std::max(reach.back, kReachBack), std::max(reach.ahead, kReachAhead)},
       filter_(sos, static_cast<Eigen::Index>(layout_.filtered.size()), tolerance) {
   if (!layout_.derived_from.empty())
-    derivative_.emplace(static_cast<Eigen::Index>(layout_.derived_from.size()), sample_period);
+    now_.derivative.emplace(static_cast<Eigen::Index>(layout_.derived_from.size()), sample_period);
   // No rows yet: a run that has not sent a sample costs no buffer (they grow on first use).
-  fifo_.resize(0, static_cast<Eigen::Index>(layout_.unfiltered.size()));
-  window_.resize(0, layout_.width());
+  now_.fifo.resize(0, static_cast<Eigen::Index>(layout_.unfiltered.size()));
+  now_.window.resize(0, layout_.width());
 }
 
-SegmentStream::SegmentStream(const SegmentStream& other)
-    : layout_(other.layout_), reach_(other.reach_), filter_(other.filter_) {
-  *this = other;
+void SegmentStream::Rows::assign_held(const Rows& other) {
+  derivative = other.derivative;
+  active = other.active;
+  start = other.start;
+  copy_rows(fifo, other.fifo, other.fifo_rows);
+  fifo_rows = other.fifo_rows;
+  copy_rows(window, other.window, other.window_rows);
+  window_first = other.window_first;
+  window_rows = other.window_rows;
+  derived_end = other.derived_end;
+  built = other.built;
 }
 
-SegmentStream& SegmentStream::operator=(const SegmentStream& other) {
-  if (this == &other) return *this;
-  layout_ = other.layout_;
-  reach_ = other.reach_;
-  filter_ = other.filter_;
-  derivative_ = other.derivative_;
-  active_ = other.active_;
-  start_ = other.start_;
-  copy_rows(fifo_, other.fifo_, other.fifo_rows_);
-  fifo_rows_ = other.fifo_rows_;
-  copy_rows(window_, other.window_, other.window_rows_);
-  window_first_ = other.window_first_;
-  window_rows_ = other.window_rows_;
-  derived_end_ = other.derived_end_;
-  built_ = other.built_;
-  return *this;
+void SegmentStream::mark() {
+  filter_.mark();
+  undo_.assign_held(now_);
+}
+
+void SegmentStream::rollback() {
+  filter_.rollback();
+  now_.assign_held(undo_);
+}
+
+void SegmentStream::commit() {
+  filter_.commit();
 }
 
 void SegmentStream::start(std::uint64_t start) {
   filter_.reset();
-  if (derivative_) derivative_->reset();
-  active_ = true;
-  start_ = start;
-  fifo_rows_ = 0;
-  window_first_ = window_rows_ = derived_end_ = built_ = 0;
+  if (now_.derivative) now_.derivative->reset();
+  now_.active = true;
+  now_.start = start;
+  now_.fifo_rows = 0;
+  now_.window_first = now_.window_rows = now_.derived_end = now_.built = 0;
 }
 
 void SegmentStream::push(const Eigen::Ref<const Eigen::MatrixXd>& raw) {
   const Eigen::Index m = raw.rows();
-  if (fifo_.rows() < fifo_rows_ + m)
-    fifo_.conservativeResize(std::max(2 * fifo_.rows(), fifo_rows_ + m), Eigen::NoChange);
+  if (now_.fifo.rows() < now_.fifo_rows + m)
+    now_.fifo.conservativeResize(std::max(2 * now_.fifo.rows(), now_.fifo_rows + m),
+                                 Eigen::NoChange);
   for (std::size_t i = 0; i < layout_.unfiltered.size(); ++i)
-    fifo_.col(static_cast<Eigen::Index>(i)).segment(fifo_rows_, m) = raw.col(layout_.unfiltered[i]);
-  fifo_rows_ += m;
+    now_.fifo.col(static_cast<Eigen::Index>(i)).segment(now_.fifo_rows, m) =
+        raw.col(layout_.unfiltered[i]);
+  now_.fifo_rows += m;
   append_final(filter_.push(gather(raw, layout_.filtered)));
 }
 
 void SegmentStream::finish() {
   append_final(filter_.finish());
-  if (!derivative_) return;
-  const Eigen::MatrixXd last = derivative_->finish();
-  window_.row(derived_end_ - window_first_).tail(last.cols()) = last.row(0);
-  ++derived_end_;
+  if (!now_.derivative) return;
+  const Eigen::MatrixXd last = now_.derivative->finish();
+  now_.window.row(now_.derived_end - now_.window_first).tail(last.cols()) = last.row(0);
+  ++now_.derived_end;
 }
 
 void SegmentStream::append_final(const Eigen::MatrixXd& filtered) {
   const Eigen::Index r = filtered.rows();
   if (r == 0) return;
-  reserve_window(window_rows_ + r);
-  const Eigen::Index base = window_rows_;
+  reserve_window(now_.window_rows + r);
+  const Eigen::Index base = now_.window_rows;
   for (std::size_t i = 0; i < layout_.filtered.size(); ++i)
-    window_.col(layout_.filtered[i]).segment(base, r) = filtered.col(static_cast<Eigen::Index>(i));
+    now_.window.col(layout_.filtered[i]).segment(base, r) =
+        filtered.col(static_cast<Eigen::Index>(i));
   // The pass-through channels of the same samples: the oldest r of the FIFO.
   for (std::size_t i = 0; i < layout_.unfiltered.size(); ++i)
-    window_.col(layout_.unfiltered[i]).segment(base, r) =
-        fifo_.col(static_cast<Eigen::Index>(i)).head(r);
-  fifo_.topRows(fifo_rows_ - r) = fifo_.middleRows(r, fifo_rows_ - r).eval();
-  fifo_rows_ -= r;
+    now_.window.col(layout_.unfiltered[i]).segment(base, r) =
+        now_.fifo.col(static_cast<Eigen::Index>(i)).head(r);
+  now_.fifo.topRows(now_.fifo_rows - r) = now_.fifo.middleRows(r, now_.fifo_rows - r).eval();
+  now_.fifo_rows -= r;
   // Derived columns are filled as the derivative releases them; defined until then.
-  window_.block(base, layout_.announced, r, window_.cols() - layout_.announced).setZero();
-  window_rows_ += r;
-  if (!derivative_) {
-    derived_end_ = window_first_ + window_rows_;
+  now_.window.block(base, layout_.announced, r, now_.window.cols() - layout_.announced).setZero();
+  now_.window_rows += r;
+  if (!now_.derivative) {
+    now_.derived_end = now_.window_first + now_.window_rows;
     return;
   }
   const Eigen::MatrixXd d =
-      derivative_->push(gather(window_.middleRows(base, r), layout_.derived_from));
-  window_.block(derived_end_ - window_first_, layout_.announced, d.rows(), d.cols()) = d;
-  derived_end_ += d.rows();
+      now_.derivative->push(gather(now_.window.middleRows(base, r), layout_.derived_from));
+  now_.window.block(now_.derived_end - now_.window_first, layout_.announced, d.rows(), d.cols()) =
+      d;
+  now_.derived_end += d.rows();
 }
 
 void SegmentStream::reserve_window(Eigen::Index rows) {
-  if (window_.rows() < rows)
-    window_.conservativeResize(std::max({2 * window_.rows(), rows, usual_window()}),
-                               Eigen::NoChange);
+  if (now_.window.rows() < rows)
+    now_.window.conservativeResize(std::max({2 * now_.window.rows(), rows, usual_window()}),
+                                   Eigen::NoChange);
 }
 
 ReadyRows SegmentStream::ready(bool at_end) const {
   const Eigen::Index ready_end =
-      at_end ? derived_end_ : std::max(built_, derived_end_ - reach_.ahead);
-  const Eigen::Index context = std::max(window_first_, built_ - reach_.back);
-  const Eigen::MatrixXd& w = window_;
-  return {w.middleRows(context - window_first_, derived_end_ - context), built_ - context,
-          ready_end - built_, context};
+      at_end ? now_.derived_end : std::max(now_.built, now_.derived_end - reach_.ahead);
+  const Eigen::Index context = std::max(now_.window_first, now_.built - reach_.back);
+  const Eigen::MatrixXd& w = now_.window;
+  return {w.middleRows(context - now_.window_first, now_.derived_end - context),
+          now_.built - context, ready_end - now_.built, context};
 }
 
 void SegmentStream::consume(Eigen::Index count) {
-  built_ += count;
-  const Eigen::Index drop = std::max<Eigen::Index>(0, built_ - reach_.back - window_first_);
+  now_.built += count;
+  const Eigen::Index drop = std::max<Eigen::Index>(0, now_.built - reach_.back - now_.window_first);
   if (drop == 0) return;
-  const Eigen::Index used = window_rows_;
-  const Eigen::Index keep = window_rows_ - drop;
-  window_.topRows(keep) = window_.middleRows(drop, keep).eval();
-  window_first_ += drop;
-  window_rows_ = keep;
+  const Eigen::Index used = now_.window_rows;
+  const Eigen::Index keep = now_.window_rows - drop;
+  now_.window.topRows(keep) = now_.window.middleRows(drop, keep).eval();
+  now_.window_first += drop;
+  now_.window_rows = keep;
   // A chunk much longer than this one grew the window: give the memory back so idle runs stay
   // small (room for what this one used stays: chunks of one size do not reallocate).
   const Eigen::Index usual = std::max(usual_window(), used);
-  if (window_.rows() > 4 * usual) window_.conservativeResize(usual, Eigen::NoChange);
+  if (now_.window.rows() > 4 * usual) now_.window.conservativeResize(usual, Eigen::NoChange);
 }
 
 void SegmentStream::held_buffers(const std::string& prefix,
@@ -158,17 +166,19 @@ void SegmentStream::held_buffers(const std::string& prefix,
     b.name = prefix + b.name;
     out.push_back(std::move(b));
   }
-  if (derivative_) {
-    const Eigen::MatrixXd recent = derivative_->state().recent;
+  if (now_.derivative) {
+    const Eigen::MatrixXd recent = now_.derivative->state().recent;
     out.push_back(signal::held_buffer(prefix + "derivative recent", recent, recent.rows()));
   }
-  out.push_back(signal::held_buffer(prefix + "pass-through FIFO", fifo_, fifo_rows_));
-  out.push_back(signal::held_buffer(prefix + "row window", window_, window_rows_));
+  out.push_back(signal::held_buffer(prefix + "pass-through FIFO", now_.fifo, now_.fifo_rows));
+  out.push_back(signal::held_buffer(prefix + "row window", now_.window, now_.window_rows));
+  out.push_back(signal::held_buffer(prefix + "undo FIFO", undo_.fifo, undo_.fifo_rows));
+  out.push_back(signal::held_buffer(prefix + "undo window", undo_.window, undo_.window_rows));
 }
 
 void SegmentStream::save(ByteWriter& w) const {
-  w.put_bool(active_);
-  w.put<std::uint64_t>(start_);
+  w.put_bool(now_.active);
+  w.put<std::uint64_t>(now_.start);
   const signal::StreamingZeroPhaseFilter::State f = filter_.state();
   put_index(w, f.samples_in);
   put_index(w, f.samples_out);
@@ -177,23 +187,23 @@ void SegmentStream::save(ByteWriter& w) const {
   w.put_matrix(f.raw_tail);
   w.put_matrix(f.forward_state);
   w.put_matrix(f.pending);
-  if (derivative_) {
-    const signal::StreamingDerivative::State d = derivative_->state();
+  if (now_.derivative) {
+    const signal::StreamingDerivative::State d = now_.derivative->state();
     put_index(w, d.samples_in);
     put_index(w, d.samples_out);
     w.put_bool(d.finished);
     w.put_matrix(d.recent);
   }
-  w.put_matrix(fifo_.topRows(fifo_rows_));
-  w.put_matrix(window_.topRows(window_rows_));
-  put_index(w, window_first_);
-  put_index(w, derived_end_);
-  put_index(w, built_);
+  w.put_matrix(now_.fifo.topRows(now_.fifo_rows));
+  w.put_matrix(now_.window.topRows(now_.window_rows));
+  put_index(w, now_.window_first);
+  put_index(w, now_.derived_end);
+  put_index(w, now_.built);
 }
 
 void SegmentStream::load(ByteReader& r) {
-  active_ = r.get_bool("segment active");
-  start_ = r.get<std::uint64_t>("segment start");
+  now_.active = r.get_bool("segment active");
+  now_.start = r.get<std::uint64_t>("segment start");
   signal::StreamingZeroPhaseFilter::State f;
   f.samples_in = get_index(r, "filter samples in");
   f.samples_out = get_index(r, "filter samples out");
@@ -203,30 +213,31 @@ void SegmentStream::load(ByteReader& r) {
   f.forward_state = r.get_matrix("filter forward state");
   f.pending = r.get_matrix("filter pending");
   filter_.restore(f);
-  if (derivative_) {
+  if (now_.derivative) {
     signal::StreamingDerivative::State d;
     d.samples_in = get_index(r, "derivative samples in");
     d.samples_out = get_index(r, "derivative samples out");
     d.finished = r.get_bool("derivative finished");
     d.recent = r.get_matrix("derivative recent");
-    derivative_->restore(d);
+    now_.derivative->restore(d);
   }
-  fifo_ = r.get_matrix("pass-through FIFO");
-  fifo_rows_ = fifo_.rows();
-  window_ = r.get_matrix("row window");
-  window_rows_ = window_.rows();
-  window_first_ = get_index(r, "window first");
-  derived_end_ = get_index(r, "derived end");
-  built_ = get_index(r, "built");
-  const Eigen::Index window_end = window_first_ + window_rows_;
-  const Eigen::Index derived = derivative_ ? derivative_->samples_out() : window_end;
-  const bool fits = fifo_.cols() == static_cast<Eigen::Index>(layout_.unfiltered.size()) &&
-                    fifo_rows_ == filter_.samples_in() - filter_.samples_out() &&
-                    window_.cols() == layout_.width() && window_end == filter_.samples_out() &&
-                    (!derivative_ || derivative_->samples_in() == window_end) &&
-                    derived_end_ == derived &&
-                    window_first_ <= std::max<Eigen::Index>(0, built_ - reach_.back) &&
-                    built_ <= derived_end_ && fifo_.allFinite() && window_.allFinite();
+  now_.fifo = r.get_matrix("pass-through FIFO");
+  now_.fifo_rows = now_.fifo.rows();
+  now_.window = r.get_matrix("row window");
+  now_.window_rows = now_.window.rows();
+  now_.window_first = get_index(r, "window first");
+  now_.derived_end = get_index(r, "derived end");
+  now_.built = get_index(r, "built");
+  const Eigen::Index window_end = now_.window_first + now_.window_rows;
+  const Eigen::Index derived = now_.derivative ? now_.derivative->samples_out() : window_end;
+  const bool fits = now_.fifo.cols() == static_cast<Eigen::Index>(layout_.unfiltered.size()) &&
+                    now_.fifo_rows == filter_.samples_in() - filter_.samples_out() &&
+                    now_.window.cols() == layout_.width() && window_end == filter_.samples_out() &&
+                    (!now_.derivative || now_.derivative->samples_in() == window_end) &&
+                    now_.derived_end == derived &&
+                    now_.window_first <= std::max<Eigen::Index>(0, now_.built - reach_.back) &&
+                    now_.built <= now_.derived_end && now_.fifo.allFinite() &&
+                    now_.window.allFinite();
   if (!fits) r.fail("segment buffers do not fit the run's layout or each other");
   reserve_window(usual_window());
 }

@@ -46,19 +46,17 @@ class SegmentStream {
  public:
   SegmentStream(const signal::Sos& sos, Layout layout, double sample_period, double tolerance,
                 model::RowReach reach);
-  /// Copies carry the live rows only; assigned into a stream of the same run it reuses the
-  /// buffers (the processor keeps a rollback copy per chunk: this makes it cheap).
-  SegmentStream(const SegmentStream& other);
-  SegmentStream& operator=(const SegmentStream& other);
+  SegmentStream(const SegmentStream&) = delete;  // one per run; undo is mark()/rollback()
+  SegmentStream& operator=(const SegmentStream&) = delete;
   SegmentStream(SegmentStream&&) noexcept = default;
   SegmentStream& operator=(SegmentStream&&) noexcept = default;
   ~SegmentStream() = default;
 
   /// Starts a new segment at grid index `start` (forgets the previous one).
   void start(std::uint64_t start);
-  void stop() { active_ = false; }
-  bool active() const { return active_; }
-  std::uint64_t start_index() const { return start_; }
+  void stop() { now_.active = false; }
+  bool active() const { return now_.active; }
+  std::uint64_t start_index() const { return now_.start; }
   Eigen::Index length() const { return filter_.samples_in(); }
   /// Enough samples for the edge extension (otherwise the segment is skipped).
   bool long_enough() const { return filter_.samples_in() > filter_.padlen(); }
@@ -68,6 +66,12 @@ class SegmentStream {
   void push(const Eigen::Ref<const Eigen::MatrixXd>& raw);
   /// Ends the segment: every sample becomes final. Needs long_enough().
   void finish();
+
+  /// Undo of what follows (pushes, finish(), a new segment): mark() saves the state, rollback()
+  /// returns to it exactly, commit() keeps the changes; see StreamingZeroPhaseFilter::mark().
+  void mark();
+  void rollback();
+  void commit();
 
   ReadyRows ready(bool at_end) const;
   /// Marks the `count` rows of the last ready() built; drops rows no later row reaches.
@@ -89,16 +93,24 @@ class SegmentStream {
   Layout layout_;
   model::RowReach reach_;
   signal::StreamingZeroPhaseFilter filter_;
-  std::optional<signal::StreamingDerivative> derivative_;
-  bool active_ = false;
-  std::uint64_t start_ = 0;
-  Eigen::MatrixXd fifo_;  // pass-through channels of samples the filter holds back
-  Eigen::Index fifo_rows_ = 0;
-  Eigen::MatrixXd window_;
-  Eigen::Index window_first_ = 0;
-  Eigen::Index window_rows_ = 0;
-  Eigen::Index derived_end_ = 0;
-  Eigen::Index built_ = 0;
+  // Everything a push changes but the filter (which undoes itself: mark()).
+  struct Rows {
+    std::optional<signal::StreamingDerivative> derivative;
+    bool active = false;
+    std::uint64_t start = 0;
+    Eigen::MatrixXd fifo;  // pass-through channels of samples the filter holds back
+    Eigen::Index fifo_rows = 0;
+    Eigen::MatrixXd window;
+    Eigen::Index window_first = 0;
+    Eigen::Index window_rows = 0;
+    Eigen::Index derived_end = 0;
+    Eigen::Index built = 0;
+    /// Takes other's state; of its FIFO and window, the held rows only (into these buffers when
+    /// they are large enough, else into new ones without room).
+    void assign_held(const Rows& other);
+  };
+  Rows now_;
+  Rows undo_;  // now_ at mark(): the few held rows of the FIFO and window, which a push moves
 };
 
 }  // namespace dynid::ingest::detail

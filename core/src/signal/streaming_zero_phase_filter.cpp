@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -201,6 +202,7 @@ StreamingZeroPhaseFilter& StreamingZeroPhaseFilter::operator=(const StreamingZer
   raw_tail_ = other.raw_tail_;
   forward_state_ = other.forward_state_;
   copy_pending(other);
+  marked_ = false;
   return *this;
 }
 
@@ -219,9 +221,51 @@ void StreamingZeroPhaseFilter::reset() {
   head_.resize(0, channels_);
   raw_tail_.resize(0, channels_);
   forward_state_.setZero(unit_state_.size(), channels_);  // defined before start: state() copies it
+  drop_pending();
+}
+
+void StreamingZeroPhaseFilter::drop_pending() {
+  pending_rows_ = 0;
+  if (marked_) {  // the marked rows stay where they are; new ones go after them
+    pending_first_ = mark_.pending_end;
+    return;
+  }
   pending_.resize(0, channels_);
   pending_first_ = 0;
-  pending_rows_ = 0;
+}
+
+void StreamingZeroPhaseFilter::mark() {
+  mark_.samples_in = n_in_;
+  mark_.samples_out = n_out_;
+  mark_.finished = finished_;
+  mark_.head = head_;
+  mark_.raw_tail = raw_tail_;
+  mark_.forward_state = forward_state_;
+  mark_.pending_first = pending_first_;
+  mark_.pending_end = pending_first_ + pending_rows_;
+  marked_ = true;
+}
+
+void StreamingZeroPhaseFilter::rollback() {
+  if (!marked_) throw std::logic_error("StreamingZeroPhaseFilter::rollback: no mark");
+  n_in_ = mark_.samples_in;
+  n_out_ = mark_.samples_out;
+  finished_ = mark_.finished;
+  head_ = mark_.head;
+  raw_tail_ = mark_.raw_tail;
+  forward_state_ = mark_.forward_state;
+  pending_first_ = mark_.pending_first;
+  pending_rows_ = mark_.pending_end - mark_.pending_first;
+  commit();
+}
+
+void StreamingZeroPhaseFilter::commit() {
+  marked_ = false;
+  if (pending_rows_ == 0 && (finished_ || n_in_ <= padlen_)) {  // as drop_pending() unmarked
+    pending_.resize(0, channels_);
+    pending_first_ = 0;
+  }
+  shrink_room();
 }
 
 Eigen::MatrixXd StreamingZeroPhaseFilter::push(const Eigen::MatrixXd& chunk) {
@@ -265,9 +309,7 @@ Eigen::MatrixXd StreamingZeroPhaseFilter::finish() {
     detail::run_backward(sos_, z.data(), out.col(c).data(), pending_rows_);
   }
   n_out_ += pending_rows_;
-  pending_first_ = 0;
-  pending_rows_ = 0;
-  pending_.resize(0, channels_);
+  drop_pending();
   finished_ = true;
   return out;
 }
@@ -306,18 +348,23 @@ Eigen::Index StreamingZeroPhaseFilter::usual_room() const {
 void StreamingZeroPhaseFilter::make_room(Eigen::Index m) {
   // Room for m more rows after the held ones: move the held rows to the top (one block move per
   // channel, seldom: only when the rows released since the last move leave too little room),
-  // and grow only when they alone do not fit.
-  if (pending_first_ + pending_rows_ + m <= pending_.rows()) return;
-  if (pending_first_ > 0) {
+  // and grow only when they alone do not fit. Under a mark, the marked rows move with them.
+  const Eigen::Index end = pending_first_ + pending_rows_;
+  if (end + m <= pending_.rows()) return;
+  const Eigen::Index from =
+      marked_ ? std::min(pending_first_, mark_.pending_first) : pending_first_;
+  if (from > 0) {
     for (Eigen::Index c = 0; c < channels_; ++c) {
       double* col = pending_.col(c).data();
-      std::memmove(col, col + pending_first_, sizeof(double) * static_cast<std::size_t>(pending_rows_));
+      std::memmove(col, col + from, sizeof(double) * static_cast<std::size_t>(end - from));
     }
-    pending_first_ = 0;
+    pending_first_ -= from;
+    mark_.pending_first -= from;
+    mark_.pending_end -= from;
   }
-  const Eigen::Index usual = usual_room();
-  if (pending_.rows() < pending_rows_ + m)
-    pending_.conservativeResize(std::max({2 * pending_.rows(), pending_rows_ + m, usual}),
+  const Eigen::Index kept = end - from;
+  if (pending_.rows() < kept + m)
+    pending_.conservativeResize(std::max({2 * pending_.rows(), kept + m, usual_room()}),
                                 Eigen::NoChange);
 }
 
@@ -359,14 +406,18 @@ Eigen::MatrixXd StreamingZeroPhaseFilter::release(Eigen::Index blocks) {
   pending_first_ += count;
   pending_rows_ -= count;
   n_out_ += count;
-  // A long chunk grew the buffer: give the memory back so idle runs stay small.
-  const Eigen::Index usual = usual_room();
-  if (pending_.rows() > 2 * usual && pending_rows_ <= usual) {
-    pending_.topRows(pending_rows_) = pending_.middleRows(pending_first_, pending_rows_).eval();
-    pending_first_ = 0;
-    pending_.conservativeResize(usual, Eigen::NoChange);
-  }
+  shrink_room();
   return out;
+}
+
+void StreamingZeroPhaseFilter::shrink_room() {
+  // A long chunk grew the buffer: give the memory back so idle runs stay small (after the
+  // mark is gone: the marked rows may not move).
+  const Eigen::Index usual = usual_room();
+  if (marked_ || pending_.rows() <= 2 * usual || pending_rows_ > usual) return;
+  pending_.topRows(pending_rows_) = pending_.middleRows(pending_first_, pending_rows_).eval();
+  pending_first_ = 0;
+  pending_.conservativeResize(usual, Eigen::NoChange);
 }
 
 StreamingZeroPhaseFilter::State StreamingZeroPhaseFilter::state() const {
@@ -378,7 +429,11 @@ std::vector<HeldBuffer> StreamingZeroPhaseFilter::held_buffers() const {
   return {held_buffer("filter head", head_, head_.rows()),
           held_buffer("filter raw tail", raw_tail_, raw_tail_.rows()),
           held_buffer("filter forward state", forward_state_, forward_state_.rows()),
-          held_buffer("filter pending", pending_, pending_rows_)};
+          held_buffer("filter pending", pending_, pending_rows_),
+          held_buffer("filter mark head", mark_.head, mark_.head.rows()),
+          held_buffer("filter mark raw tail", mark_.raw_tail, mark_.raw_tail.rows()),
+          held_buffer("filter mark forward state", mark_.forward_state,
+                      mark_.forward_state.rows())};
 }
 
 void StreamingZeroPhaseFilter::check_state(const State& s) const {
@@ -413,6 +468,7 @@ void StreamingZeroPhaseFilter::restore(const State& s) {
   pending_ = s.pending;
   pending_first_ = 0;
   pending_rows_ = s.pending.rows();
+  marked_ = false;
 }
 
 }  // namespace dynid::signal

@@ -127,8 +127,9 @@ class RunProcessor {
   /// Names and units of the derived channels made here (d_<name>), in column order.
   std::vector<std::pair<std::string, std::string>> derived_channels() const;
   /// The buffers held between pushes, for memory accounting (allocated and held bytes): the
-  /// segment's ("segment ...") and the rollback copy's ("rollback ..."), then each run model's
-  /// accumulators ("<model> accumulators"). Small fixed members are not listed.
+  /// segment's ("segment ...", with what it keeps to undo a rejected push: "... mark ...",
+  /// "... undo ..."), then each run model's accumulators ("<model> accumulators"). Small fixed
+  /// members are not listed.
   std::vector<signal::HeldBuffer> held_buffers() const;
   /// The low-pass applied (for reports and for reproducing the processing offline).
   const signal::Sos& filter() const;

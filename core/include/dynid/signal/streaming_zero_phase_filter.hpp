@@ -40,7 +40,7 @@ class StreamingZeroPhaseFilter {
   // Throws InputError otherwise.
   StreamingZeroPhaseFilter(Sos sos, Eigen::Index channels, double tolerance = 1e-10);
   // Copies carry the held samples only, not the spare buffer room; a copy assigned into a filter
-  // of the same shape reuses its buffers (what a caller keeping a rollback copy per push wants).
+  // of the same shape reuses its buffers. (To undo a push, mark() is cheaper than a copy.)
   StreamingZeroPhaseFilter(const StreamingZeroPhaseFilter& other);
   StreamingZeroPhaseFilter& operator=(const StreamingZeroPhaseFilter& other);
   StreamingZeroPhaseFilter(StreamingZeroPhaseFilter&&) noexcept = default;
@@ -60,6 +60,16 @@ class StreamingZeroPhaseFilter {
 
   // Forgets the signal, keeps the filter: ready for a new one.
   void reset();
+
+  // Undo, for a caller that must reject its input after feeding the filter (a server whose model
+  // rejects a chunk): mark() saves the state; push(), finish() and reset() may follow; rollback()
+  // returns to the mark, to the bit; commit() keeps what was done. Both drop the mark (rollback()
+  // without one is a logic_error). Cheaper than a copy: the held forward outputs, most of the
+  // state, are not copied, only kept in place until the mark is dropped (the buffer may hold
+  // them and the new ones together meanwhile). Copies and restore() carry no mark.
+  void mark();
+  void rollback();
+  void commit();
 
   // The complete state between calls, exact: restored into a filter built with the same Sos,
   // channel count and tolerance, it continues the signal to the bit (for checkpoints).
@@ -102,6 +112,8 @@ class StreamingZeroPhaseFilter {
   void keep_raw_tail(const Eigen::MatrixXd& chunk);
   void copy_pending(const StreamingZeroPhaseFilter& other);
   void make_room(Eigen::Index rows);
+  void shrink_room();
+  void drop_pending();
   // Rows the pending buffer is given when it grows, and shrunk back to after a long chunk.
   Eigen::Index usual_room() const;
 
@@ -123,6 +135,21 @@ class StreamingZeroPhaseFilter {
   Eigen::MatrixXd pending_;
   Eigen::Index pending_first_ = 0;
   Eigen::Index pending_rows_ = 0;
+
+  // The state at mark(): the pending rows [pending_first, pending_end) stay in the buffer (moved
+  // only together with the newer rows) while marked_.
+  struct Mark {
+    Eigen::Index samples_in = 0;
+    Eigen::Index samples_out = 0;
+    bool finished = false;
+    Eigen::MatrixXd head;
+    Eigen::MatrixXd raw_tail;
+    Eigen::MatrixXd forward_state;
+    Eigen::Index pending_first = 0;
+    Eigen::Index pending_end = 0;
+  };
+  Mark mark_;
+  bool marked_ = false;
 };
 
 // The number of samples after which the tail of the impulse response of `sos` is small enough
