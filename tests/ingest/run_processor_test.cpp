@@ -351,8 +351,8 @@ TEST(RunProcessor, AModelRejectingARowMidChunkChangesNoState) {
 }
 
 // What a push keeps to undo itself holds no copy of the filter's pending rows and stays small,
-// and the filter keeps the room of StreamingZeroPhaseFilter::held_buffers, over any number of
-// chunks and segments.
+// the row window keeps no room between pushes, and the filter keeps the room of
+// StreamingZeroPhaseFilter::held_buffers, over any number of chunks and segments.
 TEST(RunProcessor, HeldBuffersStayBoundedOverManyChunks) {
   const TestRun run = test::make_run(6000);  // with gaps: three segments
   RunProcessor p(run.announcement);
@@ -369,6 +369,8 @@ TEST(RunProcessor, HeldBuffersStayBoundedOverManyChunks) {
       if (b.name.find("pending") != std::string::npos) ++pending_buffers;
       if (b.name == "segment filter pending") {
         EXPECT_LE(b.allocated, 2 * unit * filtered_row) << "after chunk " << k;
+      } else if (b.name == "segment row window") {
+        EXPECT_EQ(b.allocated, b.held) << "after chunk " << k;  // no room between pushes
       } else if (b.name.find(" undo ") != std::string::npos ||
                  b.name.find(" mark ") != std::string::npos) {
         EXPECT_LE(b.allocated, unit * window_row) << b.name << " after chunk " << k;

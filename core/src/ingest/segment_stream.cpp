@@ -71,6 +71,9 @@ void SegmentStream::rollback() {
 
 void SegmentStream::commit() {
   filter_.commit();
+  // Between pushes the window holds a few rows of context: no room kept for the next push.
+  if (now_.window.rows() > now_.window_rows)
+    now_.window.conservativeResize(now_.window_rows, Eigen::NoChange);
 }
 
 void SegmentStream::start(std::uint64_t start) {
@@ -149,15 +152,10 @@ void SegmentStream::consume(Eigen::Index count) {
   now_.built += count;
   const Eigen::Index drop = std::max<Eigen::Index>(0, now_.built - reach_.back - now_.window_first);
   if (drop == 0) return;
-  const Eigen::Index used = now_.window_rows;
   const Eigen::Index keep = now_.window_rows - drop;
   now_.window.topRows(keep) = now_.window.middleRows(drop, keep).eval();
   now_.window_first += drop;
   now_.window_rows = keep;
-  // A chunk much longer than this one grew the window: give the memory back so idle runs stay
-  // small (room for what this one used stays: chunks of one size do not reallocate).
-  const Eigen::Index usual = std::max(usual_window(), used);
-  if (now_.window.rows() > 4 * usual) now_.window.conservativeResize(usual, Eigen::NoChange);
 }
 
 void SegmentStream::held_buffers(const std::string& prefix,
@@ -243,8 +241,8 @@ void SegmentStream::load(ByteReader& r) {
 }
 
 Eigen::Index SegmentStream::usual_window() const {
-  // Between pushes the window holds the context only; a push adds what the filter releases (a
-  // block at least; more for a longer chunk, the window then grows to it).
+  // A push adds what the filter releases to the context: a block at least (more for a longer
+  // chunk, the window then grows to it; commit() gives the room back).
   return filter_.block() + reach_.back + reach_.ahead;
 }
 

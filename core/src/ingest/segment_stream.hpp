@@ -68,7 +68,8 @@ class SegmentStream {
   void finish();
 
   /// Undo of what follows (pushes, finish(), a new segment): mark() saves the state, rollback()
-  /// returns to it exactly, commit() keeps the changes; see StreamingZeroPhaseFilter::mark().
+  /// returns to it exactly, commit() keeps the changes (and gives back the window's room: between
+  /// pushes it holds a few rows of context); see StreamingZeroPhaseFilter::mark().
   void mark();
   void rollback();
   void commit();
