@@ -98,10 +98,10 @@ class StreamingZeroPhaseFilter {
   // not yet released): at most delay() after any push().
   Eigen::Index buffered_samples() const { return head_.rows() + pending_rows_; }
   bool finished() const { return finished_; }
-  // The buffers held between calls (head, raw tail, forward state, pending), each with its
-  // allocated and held bytes: for memory accounting. The pending buffer's room: 2 (overlap() +
-  // block()) rows while chunks have at most overlap() + block() rows, at most twice that after
-  // any push (a longer chunk grows it, its release gives the room back); a copy has none.
+  // The buffers held between calls (head, raw tail, forward state, pending, and what mark()
+  // keeps), each with its allocated and held bytes: for memory accounting. The pending buffer's
+  // room after a push of m rows: max(overlap() + block(), the rows held before it + m), at most
+  // twice that when a longer chunk grew it before; a copy has none.
   std::vector<HeldBuffer> held_buffers() const;
 
  private:
@@ -114,7 +114,7 @@ class StreamingZeroPhaseFilter {
   void make_room(Eigen::Index rows);
   void shrink_room();
   void drop_pending();
-  // Rows the pending buffer is given when it grows, and shrunk back to after a long chunk.
+  // The pending buffer's least room: overlap() + block() rows.
   Eigen::Index usual_room() const;
 
   Sos sos_;
@@ -135,6 +135,7 @@ class StreamingZeroPhaseFilter {
   Eigen::MatrixXd pending_;
   Eigen::Index pending_first_ = 0;
   Eigen::Index pending_rows_ = 0;
+  Eigen::Index room_need_ = 0;  // rows the last push had to hold: held before it + new ones
 
   // The state at mark(): the pending rows [pending_first, pending_end) stay in the buffer (moved
   // only together with the newer rows) while marked_.
