@@ -19,8 +19,8 @@ def table(rows, dds_rate, dds_bytes):
     print()
     print("| mode | N | runs (ok) | chunks/s | rows/s ingested | rows/s folded | x ddsperf | "
           "ack p50 / p99 ms | chunk->estimate p50 / p99 ms | lost | server CPU % (per vehicle) | "
-          "RSS MB end (per vehicle, KB) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "CPU µs per row, server / generator | RSS MB end (per vehicle, KB) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     keys = sorted({(r["mode"], r["vehicles"]) for r in rows}, key=lambda k: (k[0], k[1]))
     for mode, n in keys:
         rs = [r for r in rows if r["mode"] == mode and r["vehicles"] == n]
@@ -29,6 +29,10 @@ def table(rows, dds_rate, dds_bytes):
         ingest = med([r["sample_rows_acked"] / r["stream_seconds"] for r in rs if r["stream_seconds"] > 0])
         folded = med([r["sample_rows_folded"] / r["fold_seconds"] for r in rs if r["fold_seconds"] > 0])
         cpu = med([100 * r["server_cpu_seconds"] / r["stream_seconds"] for r in rs if r["stream_seconds"] > 0])
+        # CPU per sample row: what contention on a shared machine changes least (A/B runs).
+        per_row = [r for r in rs if r["sample_rows_acked"] > 0]
+        us_server = med([1e6 * r["server_cpu_seconds"] / r["sample_rows_acked"] for r in per_row])
+        us_load = med([1e6 * r["load_cpu_seconds"] / r["sample_rows_acked"] for r in per_row])
         rss = med([r["server_rss_end_mb"] for r in rs])
         rss_per = med([1024 * (r["server_rss_end_mb"] - r["server_rss_start_mb"]) / n for r in rs])
         lost = max(r["lost"] + r["missed"] for r in rs)
@@ -36,7 +40,7 @@ def table(rows, dds_rate, dds_bytes):
               f"{chunks_s / dds_rate:.3f} | {med([r['ack_p50_ms'] for r in rs]):.1f} / "
               f"{med([r['ack_p99_ms'] for r in rs]):.1f} | {med([r['estimate_p50_ms'] for r in rs]):.1f} / "
               f"{med([r['estimate_p99_ms'] for r in rs]):.1f} | {lost} | {cpu:.0f} ({cpu / n:.2f}) | "
-              f"{rss:.1f} ({rss_per:.0f}) |")
+              f"{us_server:.2f} / {us_load:.2f} | {rss:.1f} ({rss_per:.0f}) |")
 
 
 def soak(rows):
