@@ -12,7 +12,9 @@
 // is never taken as valid.
 //
 // It keeps the chunk's encoding (encode_chunk) too: validation computes it to check the
-// checksum, and the store writes exactly those bytes.
+// checksum, and the store writes exactly those bytes. The price is the chunk's size again for
+// as long as the ValidatedChunk lives (the server's: until its batch is committed and folded,
+// at most kMaxBatch x (1 + kMaxInFlight) chunks per worker, run_service.cpp).
 //
 // Caveat: the chunk is shared, not copied; modifying it through another (non-const) pointer
 // after validation voids the check. The overload taking a Chunk by value owns its copy.
