@@ -8,6 +8,7 @@
 #include "dynid/model/effects.hpp"
 #include "dynid/residual/road_profile.hpp"
 #include "folded_rows.hpp"
+#include "hac_wald.hpp"
 
 namespace dynid::residual {
 namespace {
@@ -81,10 +82,10 @@ std::vector<Candidate> candidates_of(const model::Model& m, const std::vector<st
 }
 
 // Weighted sums of squares of the model without the candidate (every column but the last
-// effect's: a declared road profile's columns come after it) and with
-// it, on the candidate's rows, under the declared model's fixed group weights.
+// effect's: a declared road profile's columns come after it) and with it, on the rows both
+// keep, under the declared model's fixed group weights; and the HAC Wald test of its columns.
 CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, const std::vector<double>& weights,
-                     double min_drop) {
+                     int odmf) {
   std::vector<Eigen::Index> base_columns;
   for (Eigen::Index j = 0; j < static_cast<Eigen::Index>(rows.parameters.size()); ++j)
     if (j < rows.last_effect_first || j >= rows.last_effect_end) base_columns.push_back(j);
@@ -96,14 +97,11 @@ CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, const s
   s.kind = c.kind;
   s.columns = static_cast<std::size_t>(rows.last_effect_end - rows.last_effect_first);
   s.rows = after.total_rows();
+  s.rows_outside = rows.rows_outside;
   s.evaluated = true;
   const double ss_before = before.weighted_in();
   const double ss_after = after.weighted_in();
   s.in_sample_drop = ss_before > 0.0 ? 1.0 - std::sqrt(ss_after / ss_before) : 0.0;
-  const double dof = static_cast<double>(s.rows) - static_cast<double>(rows.parameters.size());
-  s.f_statistic = ss_after > 0.0 && dof > 0.0
-                      ? ((ss_before - ss_after) / static_cast<double>(s.columns)) / (ss_after / dof)
-                      : 0.0;
   const auto n = static_cast<double>(s.rows);
   s.held_out_rms_before = std::sqrt(before.weighted_out() / n);
   s.held_out_rms_after = std::sqrt(after.weighted_out() / n);
@@ -115,8 +113,22 @@ CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, const s
     ++s.folds;
     if (a < b) ++s.folds_improved;
   }
-  s.significant = s.held_out_drop >= min_drop && s.folds > 0 && s.folds_improved == s.folds;
+  const detail::WaldTest wald = detail::hac_wald_test(rows, after.all.value, after.estimator_weights,
+                                                      rows.last_effect_first, rows.last_effect_end, odmf);
+  s.testable = wald.testable;
+  s.wald_statistic = wald.statistic;
+  s.p_value = wald.p_value;
+  s.hac_lags = wald.bandwidth;
   return s;
+}
+
+// Significance once every candidate is scored: the level is shared out among them.
+void decide(ScreenResult& result, double family_error_rate) {
+  result.tests = static_cast<int>(std::count_if(result.candidates.begin(), result.candidates.end(),
+                                                [](const CandidateScore& c) { return c.evaluated; }));
+  result.level = result.tests > 0 ? family_error_rate / result.tests : 0.0;
+  for (CandidateScore& c : result.candidates)
+    c.significant = c.evaluated && c.testable && c.p_value < result.level && c.held_out_drop > 0.0;
 }
 
 bool ranks_before(const CandidateScore& a, const CandidateScore& b) {
@@ -125,6 +137,12 @@ bool ranks_before(const CandidateScore& a, const CandidateScore& b) {
   if (a.significant && a.kind != b.kind) return static_cast<int>(a.kind) < static_cast<int>(b.kind);
   if (std::abs(a.held_out_drop - b.held_out_drop) > kTie) return a.held_out_drop > b.held_out_drop;
   return static_cast<int>(a.kind) < static_cast<int>(b.kind);
+}
+
+std::string pvalue(double p) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2g", p);
+  return buf;
 }
 
 std::string percent(double fraction) {
@@ -152,14 +170,14 @@ std::string ScreenResult::verdict() const {
   if (const CandidateScore* b = best())
     return b->effect + " (" + kind_name(b->kind) + ") explains the residual of " + fit.model +
            ": held-out RMS " + percent(-b->held_out_drop) + " (in sample " +
-           percent(-b->in_sample_drop) + "), every fold of " + std::to_string(b->folds) + " improves";
+           percent(-b->in_sample_drop) + "), HAC Wald p = " + pvalue(b->p_value) + " < " +
+           pvalue(level);
   const auto first = std::find_if(candidates.begin(), candidates.end(),
                                   [](const CandidateScore& c) { return c.evaluated; });
   if (first == candidates.end()) return "no candidate effect could be tested on this run";
-  return "nothing significant: no candidate lowers the held-out RMS of " + fit.model +
-         " enough in every fold; the best, " + first->effect + ", " +
-         percent(-first->held_out_drop) + " (" + std::to_string(first->folds_improved) + " of " +
-         std::to_string(first->folds) + " folds improve)";
+  return "nothing significant at the family error rate: no candidate's HAC Wald p below " + pvalue(level) +
+         " with a held-out gain for " + fit.model + "; the best, " + first->effect + ", held-out RMS " +
+         percent(-first->held_out_drop) + ", p = " + pvalue(first->p_value);
 }
 
 ScreenResult screen_effects(const model::Model& model, const std::vector<std::string>& declared,
@@ -172,12 +190,14 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
   for (const GroupFit& g : result.fit.groups) weights.push_back(g.sigma > 0.0 ? 1.0 / g.sigma : 0.0);
   FitOptions fold_options = options.fit;
   fold_options.series = false;
+  const detail::RowSelection declared_rows = detail::kept_rows(model, declared, run, odmf);
   for (const Candidate& c : candidates_of(model, declared, run, options)) {
     std::vector<std::string> with = declared;
     with.push_back(c.effect);
     try {
-      const detail::FoldedRows rows = detail::fold_rows(model, with, run, sample_rate_hz, odmf, fold_options, false);
-      result.candidates.push_back(score(c, rows, weights, options.min_held_out_drop));
+      const detail::FoldedRows rows =
+          detail::fold_rows(model, with, run, sample_rate_hz, odmf, fold_options, true, &declared_rows);
+      result.candidates.push_back(score(c, rows, weights, odmf));
     } catch (const InputError& e) {
       CandidateScore s;
       s.effect = c.effect;
@@ -187,6 +207,7 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
       result.candidates.push_back(std::move(s));
     }
   }
+  decide(result, options.family_error_rate);
   std::stable_sort(result.candidates.begin(), result.candidates.end(), ranks_before);
   return result;
 }

@@ -58,9 +58,44 @@ std::uint64_t FoldedRows::rows() const {
   return n;
 }
 
+namespace {
+
+std::vector<Eigen::Index> decimation_grid(const ingest::PreprocessedSegment& seg, int odmf) {
+  std::vector<Eigen::Index> kept;  // rows are built at the decimation grid's samples only
+  for (Eigen::Index i = 0; i < seg.channels.samples(); ++i)
+    if (ingest::on_decimation_grid(seg, i, odmf)) kept.push_back(i);
+  return kept;
+}
+
+std::vector<std::string> without_profiles(const std::vector<std::string>& effects) {
+  std::vector<std::string> out;
+  for (const std::string& e : effects)
+    if (!is_road_profile_effect(e)) out.push_back(e);
+  return out;
+}
+
+bool listed(const std::vector<Eigen::Index>& sorted, Eigen::Index sample) {
+  return std::binary_search(sorted.begin(), sorted.end(), sample);
+}
+
+}  // namespace
+
+RowSelection kept_rows(const model::Model& model, const std::vector<std::string>& effects,
+                       const std::vector<ingest::PreprocessedSegment>& run, int odmf) {
+  const std::vector<std::string> model_effects = without_profiles(effects);
+  RowSelection out(run.size(), std::vector<std::vector<Eigen::Index>>(model.groups().size()));
+  for (std::size_t s = 0; s < run.size(); ++s) {
+    const std::vector<Eigen::Index> kept = decimation_grid(run[s], odmf);
+    if (kept.empty()) continue;
+    const std::vector<model::GroupRows> built = model.rows_at(run[s].channels, kept, model_effects);
+    for (std::size_t g = 0; g < built.size() && g < out[s].size(); ++g) out[s][g] = built[g].samples;
+  }
+  return out;
+}
+
 FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& effects,
                      const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
-                     int odmf, const FitOptions& options, bool collect) {
+                     int odmf, const FitOptions& options, bool collect, const RowSelection* only) {
   options.cross_validation.validate();
   if (odmf < 1) throw InputError("residual analysis: odmf " + std::to_string(odmf) + " < 1");
   std::vector<std::string> model_effects;
@@ -109,15 +144,17 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   std::vector<double> row(static_cast<std::size_t>(width + 1));
   for (std::size_t s = 0; s < run.size(); ++s) {
     const ingest::PreprocessedSegment& seg = run[s];
-    std::vector<Eigen::Index> kept;  // rows are built at the decimation grid's samples only
-    for (Eigen::Index i = 0; i < seg.channels.samples(); ++i)
-      if (ingest::on_decimation_grid(seg, i, odmf)) kept.push_back(i);
+    const std::vector<Eigen::Index> kept = decimation_grid(seg, odmf);
     if (kept.empty()) continue;
     const std::vector<model::GroupRows> built = model.rows_at(seg.channels, kept, model_effects);
     for (std::size_t g = 0; g < built.size(); ++g) {
       const model::GroupRows& gr = built[g];
       for (std::size_t i = 0; i < gr.samples.size(); ++i) {
         const Eigen::Index sample = gr.samples[i];
+        if (only != nullptr && !listed((*only)[s][g], sample)) {
+          ++out.rows_outside;
+          continue;
+        }
         std::fill(row.begin(), row.end(), 0.0);
         for (Eigen::Index j = 0; j < model_width; ++j)
           row[static_cast<std::size_t>(j)] = gr.W(static_cast<Eigen::Index>(i), j);
@@ -220,7 +257,8 @@ Evaluation evaluate(const FoldedRows& rows, const std::vector<Eigen::Index>& col
   e.all = std::move(fit.estimate);
   e.group_statistics = std::move(fit.groups);
   e.x = base_solution(e.all);
-  e.weights = weights.empty() ? own_weights(e.group_statistics, names) : weights;
+  e.estimator_weights = own_weights(e.group_statistics, names);
+  e.weights = weights.empty() ? e.estimator_weights : weights;
   const std::size_t group_count = names.size();
   e.rows.assign(group_count, 0);
   e.ss_measured.assign(group_count, 0.0);

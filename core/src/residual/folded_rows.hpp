@@ -22,6 +22,10 @@ struct CollectedRows {
   std::vector<std::vector<double>> values;          // per group, rows of [w y] back to back
 };
 
+/// The rows a model configuration keeps on a run: per segment, per equation group, the segment
+/// sample index of every row (increasing).
+using RowSelection = std::vector<std::vector<std::vector<Eigen::Index>>>;
+
 struct FoldedRows {
   std::vector<model::ParameterInfo> parameters;
   std::vector<std::string> groups;
@@ -33,20 +37,31 @@ struct FoldedRows {
   Eigen::Index last_effect_end = 0;
   bool last_effect_is_profile = false;
   CollectedRows collected;
+  /// Rows the configuration builds that a restriction (fold_rows' `only`) left out.
+  std::uint64_t rows_outside = 0;
   std::uint64_t rows() const;
 };
 
 /// `effects`: model and dictionary effects, and at most one road-profile effect (its columns
-/// come last). Throws InputError (missing channel, unknown effect, no row on the grid).
+/// come last). `only`, when given, keeps only the rows it lists (a candidate judged on the
+/// declared model's rows); the others are counted in rows_outside. Throws InputError (missing
+/// channel, unknown effect, no row on the grid).
 FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& effects,
                      const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
-                     int odmf, const FitOptions& options, bool collect);
+                     int odmf, const FitOptions& options, bool collect,
+                     const RowSelection* only = nullptr);
+
+/// The rows `model` with `effects` (a road profile among them changes no row) keeps on the
+/// decimation grid of `run`. Throws InputError as fold_rows.
+RowSelection kept_rows(const model::Model& model, const std::vector<std::string>& effects,
+                       const std::vector<ingest::PreprocessedSegment>& run, int odmf);
 
 struct Evaluation {
   ls::Estimate all;
   std::vector<ls::GroupStatistics> group_statistics;
   Eigen::VectorXd x;                   // the in-sample solution, 0 where not identifiable
   std::vector<double> weights;         // per group (fixed or the fit's own 1/sigma_j)
+  std::vector<double> estimator_weights;  // per group: the fit's own 1/sigma_j (x solves with these)
   std::vector<std::uint64_t> rows;     // per group
   std::vector<double> ss_measured;     // per group ||y||^2
   std::vector<double> rss_in;          // per group

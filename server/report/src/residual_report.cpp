@@ -5,12 +5,18 @@
 
 #include <fmt/format.h>
 
+#include "dynid/residual/road_profile.hpp"
+
 namespace dynid::report {
 namespace {
 
 std::string number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "-"; }
 std::string percent(double v) { return std::isfinite(v) ? fmt::format("{:.2f}", v) : "-"; }
-bool is_profile_knot(const residual::ParameterChange& p) { return p.name.find('@') != std::string::npos; }
+// A road profile's knot parameter: <profile effect>[@group]@<distance>m. Other names with '@'
+// (a dictionary term's coefficient in one equation group) are listed.
+bool is_profile_knot(const residual::ParameterChange& p) {
+  return residual::is_road_profile_effect(p.name.substr(0, p.name.find('@')));
+}
 
 }  // namespace
 
@@ -20,8 +26,8 @@ std::string format_screen_text(const residual::ScreenResult& screen, std::size_t
   for (const residual::GroupFit& g : screen.fit.groups)
     out += fmt::format("group {}: {} rows, residual RMS {} (held out {}), relative norm {:.4f}\n", g.group, g.rows,
                        number(g.rms_in_sample), number(g.rms_held_out), g.relative_norm_in_sample);
-  out += fmt::format("{:<34} {:<12} {:>10} {:>11} {:>10} {:>6}  {}\n", "candidate", "kind", "in-sample%",
-                     "held-out%", "F", "folds", "significant");
+  out += fmt::format("{:<34} {:<12} {:>10} {:>11} {:>10} {:>9} {:>6}  {}\n", "candidate", "kind", "in-sample%",
+                     "held-out%", "HAC Wald", "p", "folds", "significant");
   std::size_t shown = 0;
   std::map<std::string, std::size_t> untested;
   for (const residual::CandidateScore& c : screen.candidates) {
@@ -30,10 +36,16 @@ std::string format_screen_text(const residual::ScreenResult& screen, std::size_t
       continue;
     }
     if (shown++ >= top) continue;
-    out += fmt::format("{:<34} {:<12} {:>10.2f} {:>11.2f} {:>10.3g} {:>3}/{:<2}  {}\n", c.effect,
+    out += fmt::format("{:<34} {:<12} {:>10.2f} {:>11.2f} {:>10.3g} {:>9.2g} {:>3}/{:<2}  {}{}\n", c.effect,
                        residual::kind_name(c.kind), 100.0 * c.in_sample_drop, 100.0 * c.held_out_drop,
-                       c.f_statistic, c.folds_improved, c.folds, c.significant ? "yes" : "no");
+                       c.wald_statistic, c.p_value, c.folds_improved, c.folds,
+                       c.significant ? "yes" : (c.testable ? "no" : "not identifiable"),
+                       c.rows_outside > 0 ? fmt::format(" (on the declared rows; {} rows of its own left out)",
+                                                        c.rows_outside)
+                                          : "");
   }
+  out += fmt::format("each candidate tested at level {:.2g} ({} candidates, family error rate {:.2g})\n",
+                     screen.level, screen.tests, screen.level * screen.tests);
   if (shown > top) out += fmt::format("... and {} more tested\n", shown - top);
   for (const auto& [reason, count] : untested) out += fmt::format("not tested ({}): {}\n", count, reason);
   return out + "verdict: " + screen.verdict() + "\n";

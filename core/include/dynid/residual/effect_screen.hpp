@@ -14,16 +14,25 @@
 // for a hunt where proxies are welcome. Effects already enabled are not candidates; a
 // candidate whose channels the run lacks is listed with the reason.
 //
-// Test of a candidate C (the added-variable test, on the candidate's own rows): the rows of
-// [W | C | y] are folded into one accumulator set per cross-validation fold; the model without
-// C on the same rows comes from the same accumulators (Accumulator::select_columns), so the
-// screen needs accumulators only and could run live on the server. Reported: the in-sample drop
-// of the weighted residual RMS and the F statistic of the added columns, and the held-out
-// weighted RMS before and after with the number of folds it improves.
+// Rows: every candidate is judged on exactly the rows of the model it would extend (the
+// declared model's rows). A candidate that would change which rows the model keeps (brake drag
+// lifts the braking mask; a lag drops the rows next to a gap) is tested on the rows both keep;
+// rows it would add are left out and counted (rows_outside). Why: judged on its own rows, a
+// candidate is compared with the declared columns on rows they were never meant to fit (braking
+// rows hold the whole brake force), and wins on every run.
 //
-// Significant: the held-out weighted RMS drops by at least min_held_out_drop AND every fold
-// improves. The in-sample F is reported, not used: with autocorrelated rows it is large for
-// nearly anything.
+// Test of a candidate C (the added-variable test): the rows of [W | C | y] are folded into one
+// accumulator set per cross-validation fold; the model without C on the same rows comes from
+// the same accumulators (Accumulator::select_columns). Reported: the in-sample drop of the
+// weighted residual RMS, the held-out weighted RMS before and after with the number of folds it
+// improves, and the Wald statistic of C's coefficients with a Newey-West (HAC) covariance.
+//
+// Significant, a test with a stated error rate: the HAC Wald test rejects "C adds nothing" at
+// level family_error_rate / m (Bonferroni over the m candidates tested, so the chance that a run
+// whose model lacks nothing gets any significant candidate is at most family_error_rate), AND
+// the held-out weighted RMS drops. The HAC covariance is what makes the level hold on
+// low-passed, decimated rows: an ordinary F test counts correlated rows as independent evidence.
+// The held-out condition guards the small-sample side of the asymptotic test.
 //
 // Ranking, in tiers: significant physical effects, then a significant road profile, then
 // significant dictionary terms, then the rest; by held-out drop within a tier (ties within 1e-9
@@ -50,11 +59,15 @@ struct CandidateScore {
   std::string description;
   CandidateKind kind = CandidateKind::kDictionary;
   std::size_t columns = 0;        ///< parameters the effect adds
-  std::uint64_t rows = 0;         ///< rows of the model with the effect
+  std::uint64_t rows = 0;         ///< rows tested (the declared model's rows the candidate keeps)
+  std::uint64_t rows_outside = 0; ///< rows the candidate would add, left out (see above)
   bool evaluated = false;
   std::string note;               ///< why not evaluated (missing channel, no row...)
   double in_sample_drop = 0.0;    ///< 1 - RMS_after / RMS_before (weighted, same rows)
-  double f_statistic = 0.0;
+  bool testable = false;          ///< false: C is not identifiable on these rows
+  double wald_statistic = 0.0;    ///< HAC Wald statistic of C's coefficients, chi2(columns)
+  double p_value = 1.0;
+  int hac_lags = 0;               ///< Newey-West bandwidth (decimated rows)
   double held_out_rms_before = 0.0;  ///< weighted
   double held_out_rms_after = 0.0;
   double held_out_drop = 0.0;        ///< 1 - after / before
@@ -65,7 +78,8 @@ struct CandidateScore {
 
 struct ScreenOptions {
   FitOptions fit;
-  double min_held_out_drop = 0.05;
+  /// Chance that a run whose model lacks nothing gets a significant candidate (see above).
+  double family_error_rate = 0.01;
   bool dictionary = true;
   bool dictionary_all_channels = false;  ///< see above
   bool road_profile = true;
@@ -76,6 +90,8 @@ struct ScreenOptions {
 struct ScreenResult {
   ModelFit fit;  ///< the model as declared
   std::vector<CandidateScore> candidates;  ///< ranked; not evaluated ones last
+  int tests = 0;                 ///< candidates tested (m)
+  double level = 0.0;            ///< each candidate's test level, family_error_rate / m
   /// The best significant candidate, or nullptr when nothing is significant.
   const CandidateScore* best() const;
   /// One sentence: what explains the residual, or that nothing significant was found.
