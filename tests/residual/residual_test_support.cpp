@@ -16,7 +16,8 @@ ProcessedRun process(const sim::Run& run, const ingest::ModelSpec& spec, bool ta
   out.announcement.preprocessing.cutoff_hz = cutoff_hz;
   if (tare) sim::test::tare_for(run, sim::test::load_scenario_text("tare.toml")).apply(out.announcement);
   const std::vector<ingest::Chunk> chunks = sim::test::replay_chunks(run, name);
-  out.segments = ingest::preprocess_offline(ingest::assemble_run(out.announcement, chunks));
+  out.recorded = ingest::assemble_run(out.announcement, chunks);
+  out.segments = ingest::preprocess_offline(out.recorded);
   return out;
 }
 

@@ -13,6 +13,7 @@ namespace dynid::residual::test {
 
 struct ProcessedRun {
   ingest::RunAnnouncement announcement;
+  ingest::RecordedRun recorded;  ///< as assembled from the chunks (raw samples)
   std::vector<ingest::PreprocessedSegment> segments;
 };
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "dynid/model/registry.hpp"
+#include "dynid/residual/diagnosis.hpp"
 #include "dynid/residual/effect_comparison.hpp"
 #include "dynid/residual/effect_screen.hpp"
 #include "residual_test_support.hpp"
@@ -61,10 +62,13 @@ void expect_found_and_fixed(const Case& c, std::uint64_t seed) {
   const double rate = processed.announcement.sample_rate_hz;
   const int odmf = processed.announcement.preprocessing.odmf;
 
-  const ScreenResult screen = screen_effects(*model, c.declared, processed.segments, rate, odmf);
+  const Diagnosis diagnosis = diagnose(*model, c.declared, processed.recorded);
+  const ScreenResult& screen = diagnosis.screen;
   std::printf("\n#### %s (seed %llu): %s\n", c.title.c_str(), static_cast<unsigned long long>(seed),
               c.model.c_str());
   test::print_ranking(screen, 8);
+  std::printf("%s\n", diagnosis.statement().c_str());
+  EXPECT_EQ(diagnosis.verdict, Verdict::kExplained) << c.title << ": " << diagnosis.statement();
   const CandidateScore* best = screen.best();
   ASSERT_NE(best, nullptr) << c.title << ": nothing significant";
   EXPECT_NE(std::find(c.true_effects.begin(), c.true_effects.end(), best->effect), c.true_effects.end())
@@ -137,8 +141,8 @@ Case brake_drag() {
           {}, "drag_pressure = 3.0e5\n"};
 }
 
-// Runs whose every effect the model declares: the screen must find nothing in at least 19 of 20
-// seeds (a false alarm is any significant candidate, of any kind).
+// Runs whose every effect the model declares: the loop must call the model adequate in at least
+// 19 of 20 seeds (a false alarm is any other verdict: "explained" or "structure left").
 int false_alarms(const Case& clean, std::uint64_t first_seed, int seeds) {
   int alarms = 0;
   for (std::uint64_t seed = first_seed; seed < first_seed + static_cast<std::uint64_t>(seeds); ++seed) {
@@ -146,12 +150,10 @@ int false_alarms(const Case& clean, std::uint64_t first_seed, int seeds) {
     const ingest::ModelSpec spec = sim::test::model_spec(clean.model, clean.declared, clean.constants);
     const test::ProcessedRun processed = test::process(run, spec, clean.tare);
     const auto model = model::make_model(spec.model, spec.constants);
-    const ScreenResult screen = screen_effects(*model, clean.declared, processed.segments,
-                                               processed.announcement.sample_rate_hz,
-                                               processed.announcement.preprocessing.odmf);
+    const Diagnosis d = diagnose(*model, clean.declared, processed.recorded);
     std::printf("%s, seed %llu: %s\n", clean.title.c_str(), static_cast<unsigned long long>(seed),
-                screen.verdict().c_str());
-    if (screen.best() != nullptr) ++alarms;
+                d.statement().c_str());
+    if (d.verdict != Verdict::kAdequate) ++alarms;
   }
   std::printf("%s: %d false alarms in %d runs\n", clean.title.c_str(), alarms, seeds);
   return alarms;
@@ -162,6 +164,13 @@ Case clean_clutch() {
           {{"min_slip_speed", 2.0}, {"stick_margin", 0.4}, {"open_clamp_load", 150.0}}, true, {}, {}};
 }
 
+// A coast-down in neutral: no drive torque winds the shafts up, nothing the road-load model
+// lacks (the acceleration runs are not clean for this model: the shafts' wind-up after each
+// shift is in the rows, docs/RESIDUAL.md).
+Case clean_coast_down() {
+  return {"clean coast-down run", "coast_down.toml", "", "longitudinal_wheel", {}, {}, true, {}, {}};
+}
+
 Case clean_lateral() {
   return {"clean lateral run", "sine_steer.toml", "", "lateral_bicycle",
           {"tyre_saturation", "slip_offset", "roll_acceleration"}, {}, false, {}, {}};
@@ -170,6 +179,12 @@ Case clean_lateral() {
 // The clutch model with its viscous term and ECU offset on controlled-slip runs of a clutch whose
 // Stribeck hump lies below the masked slips: every effect in the rows is declared.
 TEST(MissingEffect, AtMostOneFalseAlarmInTwentyCleanRuns) { EXPECT_LE(false_alarms(clean_clutch(), 200, 20), 1); }
+
+// The longitudinal model on coast-downs: the noisy wheel-speed derivative makes the accelerometer
+// a "significant" candidate in every run, yet the residual is at the noise floor (issue 15).
+TEST(MissingEffect, AtMostOneFalseAlarmInTwentyCleanCoastDowns) {
+  EXPECT_LE(false_alarms(clean_coast_down(), 400, 20), 1);
+}
 
 // The same for the lateral model with the accuracy test's effects (tests/sim/test_accuracy.cpp),
 // on five seeds (its residual keeps the tyres' load sensitivity, which no effect declares).

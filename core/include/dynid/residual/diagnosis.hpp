@@ -1,0 +1,91 @@
+#pragma once
+// Diagnosis: the residual loop's judgement of one model on one stored run, in one of three
+// verdicts, each said plainly:
+//   adequate        the residual is at the noise floor (noise_floor.hpp): nothing to explain.
+//   explained       above the floor, and a candidate effect is significant (effect_screen.hpp).
+//   structure left  above the floor, and no candidate explains it: its signature says where to
+//                   look (which channel and lag the residual correlates with, which time span of
+//                   the run holds the most of it, which frequency).
+//
+// The order is a closed test, so that the chance of an alarm on a run whose model lacks nothing
+// is stated: the floor test comes first, at level floor.error_rate (default 0.05: at most one
+// false alarm in 20 clean runs); only a residual above the floor is explained. Candidates are
+// then judged by the screen (HAC Wald test at family_error_rate / m, and a held-out gain), and a
+// significant candidate that takes the residual below the floor (its mean square under the
+// floor's lower critical ratio) is refused: a missing effect adds to the noise, so removing it
+// can bring the residual down to the floor, not under it. Only a better sensor of a declared
+// signal does that (the accelerometer standing in for a noisy differentiated wheel speed:
+// significant in every clean run, measured), and it is reported as such. A candidate can be
+// significant on a run whose residual is at the floor; it is listed, the verdict stays
+// "adequate", and the report says why.
+//
+// The signature's correlations: for every announced channel and its derivative (the model's
+// measured side excepted: the residual is part of it) and the run's time (a drift), the
+// normalised cross-correlation of the residual with the channel delayed by every lag of the
+// decimated grid within +-max_lag_s (positive: the residual follows the channel). Its standard
+// deviation under "no relation" is Bartlett's, sqrt((1 + 2 sum_j rho_rr(j) rho_uu(j)) / n), which
+// holds for two autocorrelated series; a correlation is significant beyond the normal quantile
+// 1 - error_rate / (2 M), M the number of correlations computed (Bonferroni).
+#include <map>
+#include <string>
+#include <vector>
+
+#include "dynid/ingest/recorded_run.hpp"
+#include "dynid/model/model.hpp"
+#include "dynid/residual/effect_screen.hpp"
+#include "dynid/residual/noise_floor.hpp"
+
+namespace dynid::residual {
+
+struct CorrelationFinding {
+  std::string group;
+  std::string channel;      ///< a channel, d_<channel>, or "time"
+  double lag_s = 0.0;       ///< > 0: the residual follows the channel by this long
+  double correlation = 0.0;
+  double bound = 0.0;       ///< the significance bound on |correlation| at this lag
+};
+
+struct Signature {
+  std::vector<CorrelationFinding> correlations;  ///< significant, strongest (|c| / bound) first, <= 8
+  std::string span_group;
+  double span_start_s = 0.0;  ///< the cross-validation block whose residual RMS over the floor
+  double span_end_s = 0.0;    ///< is highest
+  double span_ratio = 0.0;    ///< that block's residual RMS / floor RMS
+  double peak_frequency_hz = 0.0;  ///< of the residual's amplitude spectrum, DC excepted
+};
+
+enum class Verdict { kAdequate, kExplained, kStructureLeft };
+const char* verdict_name(Verdict verdict);
+
+struct DiagnosisOptions {
+  ScreenOptions screen;
+  NoiseFloorOptions floor;
+  std::map<std::string, double> declared_noise;  ///< channel -> sigma, from the profile
+  double max_lag_s = 1.0;
+  double error_rate = 0.01;  ///< of the signature's correlations
+};
+
+struct RefusedCandidate {
+  std::string effect;
+  std::string reason;
+};
+
+struct Diagnosis {
+  NoiseFloor floor;
+  ScreenResult screen;
+  /// The significant candidate that explains the residual (nullptr unless kExplained); points
+  /// into screen.candidates.
+  const CandidateScore* accepted = nullptr;
+  std::vector<RefusedCandidate> refused;  ///< significant candidates refused, with the reason
+  Signature signature;
+  Verdict verdict = Verdict::kAdequate;
+  /// One paragraph: the verdict and its evidence.
+  std::string statement() const;
+};
+
+/// Diagnoses `model` with its `declared` effects on `run` (assembled, not preprocessed: the
+/// floor needs the raw samples). InputError as screen_effects.
+Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
+                   const ingest::RecordedRun& run, const DiagnosisOptions& options = {});
+
+}  // namespace dynid::residual

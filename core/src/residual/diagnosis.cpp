@@ -1,0 +1,300 @@
+#include "dynid/residual/diagnosis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+
+#include <boost/math/distributions/normal.hpp>
+
+#include "dynid/error.hpp"
+
+namespace dynid::residual {
+namespace {
+
+// A channel's values at the residual's rows delayed by `lag` grid samples (NaN where the
+// delayed sample falls outside the row's segment).
+class ChannelAtRows {
+ public:
+  ChannelAtRows(const std::vector<ingest::PreprocessedSegment>& run, const std::vector<Eigen::Index>& grid)
+      : run_(run), grid_(grid) {
+    for (Eigen::Index g : grid) {
+      std::size_t s = 0;
+      while (s < run.size() && !(g >= run[s].first && g < run[s].first + run[s].channels.samples())) ++s;
+      segment_.push_back(s);
+    }
+  }
+  Eigen::VectorXd values(const std::string& channel, Eigen::Index lag) const {
+    Eigen::VectorXd out(static_cast<Eigen::Index>(grid_.size()));
+    for (std::size_t i = 0; i < grid_.size(); ++i) {
+      out(static_cast<Eigen::Index>(i)) = std::numeric_limits<double>::quiet_NaN();
+      if (segment_[i] >= run_.size()) continue;
+      const ingest::PreprocessedSegment& seg = run_[segment_[i]];
+      const Eigen::Index k = grid_[i] - lag - seg.first;
+      if (k >= 0 && k < seg.channels.samples() && seg.channels.valid(k))
+        out(static_cast<Eigen::Index>(i)) = seg.channels[channel](k);
+    }
+    return out;
+  }
+
+ private:
+  const std::vector<ingest::PreprocessedSegment>& run_;
+  const std::vector<Eigen::Index>& grid_;
+  std::vector<std::size_t> segment_;
+};
+
+// Autocorrelation of x (demeaned, NaN-free) at lags 1..max between rows one decimation step
+// apart, by grid distance.
+std::vector<double> autocorrelation(const Eigen::VectorXd& x, const std::vector<Eigen::Index>& grid, int odmf,
+                                    int max) {
+  std::vector<double> out(static_cast<std::size_t>(max + 1), 0.0);
+  const double ss = x.squaredNorm();
+  if (ss <= 0.0) return out;
+  for (std::size_t i = 0; i < grid.size(); ++i)
+    for (std::size_t j = i; j-- > 0;) {
+      const Eigen::Index lag = (grid[i] - grid[j]) / odmf;
+      if (lag > max) break;
+      out[static_cast<std::size_t>(lag)] += x(static_cast<Eigen::Index>(i)) * x(static_cast<Eigen::Index>(j));
+    }
+  for (double& v : out) v /= ss;
+  return out;
+}
+
+Eigen::VectorXd demeaned(Eigen::VectorXd x) {
+  x.array() -= x.mean();
+  return x;
+}
+
+// The correlation of r with u over the rows where u is defined; n is that count.
+double correlation(const Eigen::VectorXd& r, const Eigen::VectorXd& u, Eigen::Index& n) {
+  double mr = 0.0, mu = 0.0;
+  n = 0;
+  for (Eigen::Index i = 0; i < r.size(); ++i)
+    if (std::isfinite(u(i))) mr += r(i), mu += u(i), ++n;
+  if (n < 3) return 0.0;
+  mr /= static_cast<double>(n);
+  mu /= static_cast<double>(n);
+  double ru = 0.0, rr = 0.0, uu = 0.0;
+  for (Eigen::Index i = 0; i < r.size(); ++i)
+    if (std::isfinite(u(i))) {
+      ru += (r(i) - mr) * (u(i) - mu);
+      rr += (r(i) - mr) * (r(i) - mr);
+      uu += (u(i) - mu) * (u(i) - mu);
+    }
+  return rr > 0.0 && uu > 0.0 ? ru / std::sqrt(rr * uu) : 0.0;
+}
+
+struct SignatureInputs {
+  const model::Model& model;
+  const std::vector<ingest::PreprocessedSegment>& run;
+  const ModelFit& fit;
+  const NoiseFloor& floor;
+  double rate;
+  int odmf;
+  double block_seconds;
+};
+
+std::vector<std::string> signature_channels(const SignatureInputs& in) {
+  std::vector<std::string> out;
+  const std::vector<std::string> measured = in.model.measured_side();
+  for (const std::string& name : in.run.front().channels.names()) {
+    const std::string base = name.rfind("d_", 0) == 0 ? name.substr(2) : name;
+    if (std::find(measured.begin(), measured.end(), base) == measured.end()) out.push_back(name);
+  }
+  return out;
+}
+
+void add_correlations(const SignatureInputs& in, const ResidualSeries& s, double error_rate, double max_lag_s,
+                      std::vector<CorrelationFinding>& found) {
+  std::vector<Eigen::Index> grid;
+  for (double t : s.time_s) grid.push_back(static_cast<Eigen::Index>(std::llround(t * in.rate)));
+  const ChannelAtRows at(in.run, grid);
+  const Eigen::VectorXd r = demeaned(s.residual);
+  const int lags = std::max(0, static_cast<int>(std::floor(max_lag_s * in.rate / in.odmf)));
+  const std::vector<double> rho_r = autocorrelation(r, grid, in.odmf, lags);
+  const std::vector<std::string> channels = signature_channels(in);
+  const double tests = static_cast<double>(channels.size() * static_cast<std::size_t>(2 * lags + 1) + 1) *
+                       static_cast<double>(in.fit.groups.size());
+  const double z = boost::math::quantile(boost::math::normal(), 1.0 - error_rate / (2.0 * tests));
+  auto test = [&](const std::string& name, const std::vector<double>& rho_u, Eigen::Index lag,
+                  const Eigen::VectorXd& u) {
+    Eigen::Index n = 0;
+    const double c = correlation(r, u, n);
+    double sum = 0.0;
+    for (std::size_t j = 1; j < rho_u.size() && j < rho_r.size(); ++j) sum += rho_r[j] * rho_u[j];
+    const double bound = z * std::sqrt(std::max(1.0, 1.0 + 2.0 * sum) / static_cast<double>(std::max<Eigen::Index>(n, 1)));
+    if (std::abs(c) > bound)
+      found.push_back({s.group, name, static_cast<double>(lag) / in.rate, c, bound});
+  };
+  for (const std::string& name : channels) {
+    const Eigen::VectorXd u0 = at.values(name, 0);
+    if (!u0.allFinite() || (u0.array() - u0.mean()).matrix().squaredNorm() <= 0.0) continue;
+    const std::vector<double> rho_u = autocorrelation(demeaned(u0), grid, in.odmf, lags);
+    for (int k = -lags; k <= lags; ++k) {
+      const Eigen::Index lag = static_cast<Eigen::Index>(k) * in.odmf;
+      test(name, rho_u, lag, k == 0 ? u0 : at.values(name, lag));
+    }
+  }
+  Eigen::VectorXd time(static_cast<Eigen::Index>(s.time_s.size()));
+  for (std::size_t i = 0; i < s.time_s.size(); ++i) time(static_cast<Eigen::Index>(i)) = s.time_s[i];
+  if (time.size() > 2) test("time", autocorrelation(demeaned(time), grid, in.odmf, lags), 0, time);
+}
+
+void locate_span(const SignatureInputs& in, const ResidualSeries& s, double floor_rms, Signature& out) {
+  if (!(floor_rms > 0.0) || s.time_s.empty()) return;
+  std::map<long, std::pair<double, long>> blocks;
+  for (std::size_t i = 0; i < s.time_s.size(); ++i) {
+    auto& b = blocks[static_cast<long>(std::floor(s.time_s[i] / in.block_seconds))];
+    b.first += s.residual(static_cast<Eigen::Index>(i)) * s.residual(static_cast<Eigen::Index>(i));
+    ++b.second;
+  }
+  for (const auto& [block, sums] : blocks) {
+    const double ratio = std::sqrt(sums.first / static_cast<double>(sums.second)) / floor_rms;
+    if (ratio > out.span_ratio) {
+      out.span_ratio = ratio;
+      out.span_group = s.group;
+      out.span_start_s = static_cast<double>(block) * in.block_seconds;
+      out.span_end_s = out.span_start_s + in.block_seconds;
+    }
+  }
+}
+
+double peak_frequency(const Spectrum& spectrum) {
+  double best = 0.0;
+  double frequency = 0.0;
+  for (Eigen::Index i = 1; i < spectrum.amplitude.size(); ++i)
+    if (spectrum.amplitude(i) > best) best = spectrum.amplitude(i), frequency = spectrum.frequency_hz(i);
+  return frequency;
+}
+
+Signature signature_of(const SignatureInputs& in, const DiagnosisOptions& options) {
+  Signature out;
+  for (const ResidualSeries& s : in.fit.series) {
+    add_correlations(in, s, options.error_rate, options.max_lag_s, out.correlations);
+    const auto g = std::find_if(in.floor.groups.begin(), in.floor.groups.end(),
+                                [&](const GroupFloor& f) { return f.group == s.group; });
+    if (g != in.floor.groups.end()) locate_span(in, s, g->floor_rms, out);
+  }
+  std::sort(out.correlations.begin(), out.correlations.end(), [](const auto& a, const auto& b) {
+    return std::abs(a.correlation) / a.bound > std::abs(b.correlation) / b.bound;
+  });
+  // One line per channel and group: its strongest lag.
+  std::vector<CorrelationFinding> kept;
+  for (const CorrelationFinding& f : out.correlations) {
+    const bool seen = std::any_of(kept.begin(), kept.end(), [&](const CorrelationFinding& k) {
+      return k.channel == f.channel && k.group == f.group;
+    });
+    if (!seen && kept.size() < 8) kept.push_back(f);
+  }
+  out.correlations = std::move(kept);
+  if (!in.fit.series.empty()) out.peak_frequency_hz = peak_frequency(in.fit.series.front().spectrum);
+  return out;
+}
+
+std::string format(const char* pattern, double a, double b = 0.0, double c = 0.0) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, pattern, a, b, c);
+  return buf;
+}
+
+// The lowest ratio of squares (residual / floor) a model that lacks nothing reaches, per group:
+// the floor test's band mirrored.
+double lowest_ratio(const GroupFloor& g) { return 1.0 / g.upper_ratio; }
+
+// The first significant candidate in the screen's ranking that does not take the residual below
+// the floor; the ones that do are refused with the reason.
+void accept_best(Diagnosis& d) {
+  for (const CandidateScore& c : d.screen.candidates) {
+    if (!c.significant) break;  // ranked: the significant ones come first
+    const double kept = (1.0 - c.in_sample_drop) * (1.0 - c.in_sample_drop);
+    const GroupFloor* under = nullptr;
+    for (const GroupFloor& g : d.floor.groups)
+      if (g.rows > 0 && g.ratio * kept < lowest_ratio(g)) under = &g;
+    if (under == nullptr) {
+      d.accepted = &c;
+      return;
+    }
+    d.refused.push_back({c.effect, "takes the " + under->group + " residual below the noise floor" +
+                                       format(" (ratio of squares %.2g, at least %.2g expected)",
+                                              under->ratio * kept, lowest_ratio(*under)) +
+                                       ": it fits the noise of a declared signal (a better sensor of it), "
+                                       "not a missing effect"});
+  }
+}
+
+}  // namespace
+
+const char* verdict_name(Verdict verdict) {
+  switch (verdict) {
+    case Verdict::kAdequate: return "adequate";
+    case Verdict::kExplained: return "explained";
+    case Verdict::kStructureLeft: return "structure left";
+  }
+  return "?";
+}
+
+std::string Diagnosis::statement() const {
+  std::string floors;
+  for (const GroupFloor& g : floor.groups)
+    if (g.rows > 0)
+      floors += (floors.empty() ? "" : "; ") + g.group +
+                format(" residual RMS %.4g, noise floor %.4g (ratio of squares %.3g", g.residual_rms, g.floor_rms,
+                       g.ratio) +
+                format(", at the floor up to %.3g)", g.upper_ratio);
+  std::string out;
+  switch (verdict) {
+    case Verdict::kAdequate: {
+      out = "adequate: the residual of " + screen.fit.model + " is at the noise floor (" + floors + ")";
+      if (const CandidateScore* b = screen.best())
+        out += "; " + b->effect +
+               " is significant all the same: at the floor it can only be fitting the regressors' noise "
+               "(a better sensor of a declared signal) or a structure smaller than the noise, not a "
+               "missing effect";
+      return out;
+    }
+    case Verdict::kExplained:
+      return "explained: above the noise floor (" + floors + "); " + accepted->effect + " (" +
+             kind_name(accepted->kind) + ") explains it: held-out RMS " +
+             format("%+.1f %%", -100.0 * accepted->held_out_drop) +
+             format(", HAC Wald p = %.2g < %.2g", accepted->p_value, screen.level);
+    case Verdict::kStructureLeft:
+      break;
+  }
+  out = "structure left that no candidate explains: above the noise floor (" + floors + ")";
+  for (const RefusedCandidate& r : refused) out += "; " + r.effect + " refused: " + r.reason;
+  if (!signature.correlations.empty()) {
+    const CorrelationFinding& f = signature.correlations.front();
+    out += "; the residual correlates with " + f.channel + format(" at lag %+.0f ms (r = %.2f, bound %.2f)", 1000.0 * f.lag_s, f.correlation, f.bound);
+  }
+  if (signature.span_ratio > 0.0)
+    out += format("; most of it in %.0f-%.0f s (RMS %.2g times the floor)", signature.span_start_s,
+                  signature.span_end_s, signature.span_ratio);
+  if (signature.peak_frequency_hz > 0.0) out += format("; spectrum peak at %.2f Hz", signature.peak_frequency_hz);
+  return out;
+}
+
+Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
+                   const ingest::RecordedRun& run, const DiagnosisOptions& options) {
+  const std::vector<ingest::PreprocessedSegment> segments = ingest::preprocess_offline(run);
+  if (segments.empty()) throw InputError("residual analysis of " + model.name() + ": the run has no valid segment");
+  const double rate = run.announcement.sample_rate_hz;
+  const int odmf = run.announcement.preprocessing.odmf;
+  Diagnosis d;
+  d.screen = screen_effects(model, declared, segments, rate, odmf, options.screen);
+  NoiseFloorOptions floor_options = options.floor;
+  floor_options.fit = options.screen.fit;
+  d.floor = noise_floor(model, declared, run, measure_channel_noise(run, options.declared_noise), floor_options);
+  if (d.floor.adequate()) {
+    d.verdict = Verdict::kAdequate;
+    return d;
+  }
+  accept_best(d);
+  d.verdict = d.accepted != nullptr ? Verdict::kExplained : Verdict::kStructureLeft;
+  const SignatureInputs in{model, segments, d.screen.fit, d.floor, rate, odmf,
+                           options.screen.fit.cross_validation.block_seconds};
+  d.signature = signature_of(in, options);
+  return d;
+}
+
+}  // namespace dynid::residual

@@ -1,0 +1,329 @@
+#include "dynid/residual/noise_floor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <limits>
+#include <random>
+
+#include <Eigen/QR>
+#include <boost/math/distributions/normal.hpp>
+
+#include "dynid/error.hpp"
+#include "folded_rows.hpp"
+
+namespace dynid::residual {
+namespace {
+
+constexpr Eigen::Index kWelchLength = 256;
+constexpr double kBandLow = 1.5;   // x cut-off
+constexpr double kBandHigh = 3.0;  // x cut-off
+constexpr int kMaxLags = 40;       // decimated rows, for the effective number of rows
+
+bool filtered(const ingest::RunAnnouncement& a, const std::string& channel) {
+  const auto& pass = a.preprocessing.unfiltered;
+  return std::find(pass.begin(), pass.end(), channel) == pass.end();
+}
+
+// One-sided PSD of x at the bins of [low, high] Hz: Hann windows of kWelchLength, half
+// overlapping; the DFT is evaluated at the band's bins only. Keeps every window's periodogram
+// value per bin so that segments pool and the median can be taken: the median over windows
+// (Welch's mean made robust, divided by ln 2, the median of an exponential variable over its
+// mean) ignores the few windows that hold a transient (a gear shift rings the driveline above
+// the cut-off for a second), which are signal, not noise.
+struct BandPsd {
+  std::vector<double> frequency;
+  std::vector<std::vector<double>> values;  // [bin][window]
+  long windows = 0;
+  double level(std::size_t bin) const {
+    std::vector<double> v = values[bin];
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2] / std::numbers::ln2;
+  }
+};
+
+void add_band_psd(const Eigen::VectorXd& x, double rate, BandPsd& psd) {
+  const Eigen::Index n = kWelchLength;
+  Eigen::VectorXd window(n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    window(i) = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(n));
+  const double window_power = window.squaredNorm();
+  for (Eigen::Index start = 0; start + n <= x.size(); start += n / 2) {
+    Eigen::VectorXd piece = x.segment(start, n);
+    piece.array() -= piece.mean();
+    piece.array() *= window.array();
+    for (std::size_t b = 0; b < psd.frequency.size(); ++b) {
+      double re = 0.0;
+      double im = 0.0;
+      const double w = 2.0 * std::numbers::pi * psd.frequency[b] / rate;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        re += piece(i) * std::cos(w * static_cast<double>(i));
+        im -= piece(i) * std::sin(w * static_cast<double>(i));
+      }
+      psd.values[b].push_back(2.0 * (re * re + im * im) / (rate * window_power));
+    }
+    ++psd.windows;
+  }
+}
+
+BandPsd band_bins(double rate, double low, double high) {
+  BandPsd psd;
+  const double resolution = rate / static_cast<double>(kWelchLength);
+  for (auto k = static_cast<long>(std::ceil(low / resolution)); static_cast<double>(k) * resolution <= high; ++k)
+    psd.frequency.push_back(static_cast<double>(k) * resolution);
+  psd.values.resize(psd.frequency.size());
+  return psd;
+}
+
+// The mean noise PSD inside the band [0, cutoff], extrapolated from the bins above it. A noise
+// spectrum is even in f and smooth near 0, so its logarithm is a + b f^2 there (least squares
+// over the bins' log levels); a channel interpolated onto the grid from a slower message falls
+// off as sinc^4, which is that shape to second order. The in-band mean is the mean of
+// exp(a + b f^2) over [0, fc]. The slope is kept even where it is not significant: nearly every
+// channel is interpolated onto the grid between frames, which tilts even white sensor noise (a
+// frame time 30 % of a step from the grid mixes two frames: 12 % more noise power below the
+// cut-off than between 1.5 and 3 times it, measured on coast-downs as a floor 8-17 % low when the
+// slope was dropped); the extrapolation's extra variance is counted (level_relative_variance).
+double in_band_level(const BandPsd& psd, double cutoff) {
+  const auto bins = static_cast<Eigen::Index>(psd.frequency.size());
+  Eigen::MatrixXd a(bins, 2);
+  Eigen::VectorXd level(bins);
+  for (Eigen::Index b = 0; b < bins; ++b) {
+    a(b, 0) = 1.0;
+    a(b, 1) = psd.frequency[static_cast<std::size_t>(b)] * psd.frequency[static_cast<std::size_t>(b)];
+    level(b) = psd.level(static_cast<std::size_t>(b));
+  }
+  const double mean = level.mean();
+  if (bins < 4 || (level.array() <= 0.0).any()) return mean;
+  const Eigen::VectorXd y = level.array().log().matrix();
+  const Eigen::Vector2d c = a.colPivHouseholderQr().solve(y);
+  constexpr int kSteps = 64;  // midpoint rule over [0, fc]
+  double sum = 0.0;
+  for (int i = 0; i < kSteps; ++i) {
+    const double f = cutoff * (static_cast<double>(i) + 0.5) / kSteps;
+    sum += std::exp(c(0) + c(1) * f * f);
+  }
+  const double extrapolated = sum / kSteps;
+  return std::isfinite(extrapolated) && extrapolated > 0.0 ? extrapolated : mean;
+}
+
+// The relative variance of in_band_level: a bootstrap over the windows (the same windows for
+// every bin, so that the bins' correlation is kept), kBootstrap resamples, a fixed seed.
+double level_relative_variance(const BandPsd& psd, double cutoff, double level) {
+  constexpr int kBootstrap = 40;
+  std::mt19937_64 rng(0x6e6f697365ULL);
+  std::uniform_int_distribution<std::size_t> pick(0, psd.values.front().size() - 1);
+  double sum = 0.0;
+  double square = 0.0;
+  for (int b = 0; b < kBootstrap; ++b) {
+    BandPsd resampled{psd.frequency, std::vector<std::vector<double>>(psd.values.size()), psd.windows};
+    for (std::size_t w = 0; w < psd.values.front().size(); ++w) {
+      const std::size_t from = pick(rng);
+      for (std::size_t bin = 0; bin < psd.values.size(); ++bin) resampled.values[bin].push_back(psd.values[bin][from]);
+    }
+    const double v = in_band_level(resampled, cutoff);
+    sum += v;
+    square += v * v;
+  }
+  const double mean = sum / kBootstrap;
+  const double variance = std::max(0.0, square / kBootstrap - mean * mean);
+  return level > 0.0 ? variance / (level * level) : 0.0;
+}
+
+// The residual y - W x of every collected row, per group, with its grid index (increasing).
+using GridResiduals = std::vector<std::vector<std::pair<Eigen::Index, double>>>;
+
+GridResiduals residuals_at(const detail::FoldedRows& rows, const Eigen::VectorXd& x) {
+  const auto width = static_cast<Eigen::Index>(rows.parameters.size());
+  GridResiduals out(rows.collected.values.size());
+  for (std::size_t g = 0; g < out.size(); ++g) {
+    const std::vector<double>& v = rows.collected.values[g];
+    const Eigen::Index m = static_cast<Eigen::Index>(v.size()) / (width + 1);
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> all(
+        v.data(), m, width + 1);
+    const Eigen::VectorXd r = all.col(width) - all.leftCols(width) * x;
+    for (Eigen::Index i = 0; i < m; ++i)
+      out[g].emplace_back(rows.collected.grid_index[g][static_cast<std::size_t>(i)], r(i));
+    std::sort(out[g].begin(), out[g].end());
+  }
+  return out;
+}
+
+// What one draw's noise did to the residual, at the rows both runs keep.
+std::vector<std::pair<Eigen::Index, double>> difference(const std::vector<std::pair<Eigen::Index, double>>& noisy,
+                                                        const std::vector<std::pair<Eigen::Index, double>>& base) {
+  std::vector<std::pair<Eigen::Index, double>> out;
+  std::size_t j = 0;
+  for (const auto& [grid, r] : noisy) {
+    while (j < base.size() && base[j].first < grid) ++j;
+    if (j < base.size() && base[j].first == grid) out.emplace_back(grid, r - base[j].second);
+  }
+  return out;
+}
+
+// Sums of the noise residual's squares and lagged products, over draws.
+struct LagSums {
+  double square = 0.0;
+  std::vector<double> lagged = std::vector<double>(kMaxLags + 1, 0.0);
+  long rows = 0;
+  void add(const std::vector<std::pair<Eigen::Index, double>>& d, int odmf) {
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      square += d[i].second * d[i].second;
+      ++rows;
+      for (std::size_t j = i; j-- > 0;) {
+        const Eigen::Index lag = (d[i].first - d[j].first) / odmf;
+        if (lag > kMaxLags) break;
+        lagged[static_cast<std::size_t>(lag)] += d[i].second * d[j].second;
+      }
+    }
+  }
+  // n / (1 + 2 sum rho_k^2), the sum stopped at the first lag within the noise of rho.
+  double effective_rows(double n) const {
+    if (square <= 0.0) return n;
+    const double noise = 2.0 / std::sqrt(static_cast<double>(rows));
+    double sum = 0.0;
+    for (int k = 1; k <= kMaxLags; ++k) {
+      const double rho = lagged[static_cast<std::size_t>(k)] / square;
+      if (std::abs(rho) < noise) break;
+      sum += rho * rho;
+    }
+    return n / (1.0 + 2.0 * sum);
+  }
+};
+
+ingest::RecordedRun with_noise(const ingest::RecordedRun& run, Eigen::Index column, double sigma,
+                               std::mt19937_64& rng) {
+  ingest::RecordedRun noisy = run;
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (Eigen::Index i = 0; i < noisy.samples.rows(); ++i) noisy.samples(i, column) += sigma * normal(rng);
+  return noisy;
+}
+
+Eigen::Index column_of(const ingest::RunAnnouncement& a, const std::string& channel) {
+  for (std::size_t j = 0; j < a.channels.size(); ++j)
+    if (a.channels[j].name == channel) return static_cast<Eigen::Index>(j);
+  return -1;
+}
+
+}  // namespace
+
+std::vector<ChannelNoise> measure_channel_noise(const ingest::RecordedRun& run,
+                                                const std::map<std::string, double>& declared) {
+  const ingest::RunAnnouncement& a = run.announcement;
+  const double rate = a.sample_rate_hz;
+  const double cutoff = a.preprocessing.cutoff(rate);
+  const double low = kBandLow * cutoff;
+  const double high = std::min(kBandHigh * cutoff, 0.9 * rate / 2.0);
+  const std::vector<ingest::PreprocessedSegment> segments = ingest::preprocess_offline(run);
+  std::vector<ChannelNoise> out;
+  for (std::size_t j = 0; j < a.channels.size(); ++j) {
+    const std::string& name = a.channels[j].name;
+    if (!filtered(a, name)) continue;
+    if (const auto d = declared.find(name); d != declared.end()) {
+      out.push_back({name, d->second, "declared"});
+      continue;
+    }
+    BandPsd psd = band_bins(rate, low, high);
+    for (const ingest::PreprocessedSegment& s : segments) {
+      const Eigen::Index length = s.channels.samples();
+      const Eigen::Index at = s.first - static_cast<Eigen::Index>(run.first_sample_index);
+      const Eigen::VectorXd raw = run.samples.block(at, static_cast<Eigen::Index>(j), length, 1);
+      add_band_psd(raw - s.channels[name], rate, psd);
+    }
+    if (psd.windows == 0 || psd.frequency.empty()) {
+      out.push_back({name, 0.0, "not measured"});
+      continue;
+    }
+    const double level = in_band_level(psd, cutoff);
+    out.push_back({name, std::sqrt(level * rate / 2.0), "measured above the cut-off",
+                   level_relative_variance(psd, cutoff, level)});
+  }
+  return out;
+}
+
+bool NoiseFloor::adequate() const {
+  return std::all_of(groups.begin(), groups.end(), [](const GroupFloor& g) { return g.rows == 0 || g.at_floor; });
+}
+
+NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>& effects,
+                       const ingest::RecordedRun& run, const std::vector<ChannelNoise>& noise,
+                       const NoiseFloorOptions& options) {
+  if (options.draws < 1) throw InputError("noise floor: draws " + std::to_string(options.draws) + " < 1");
+  const std::vector<ingest::PreprocessedSegment> segments = ingest::preprocess_offline(run);
+  if (segments.empty()) throw InputError("noise floor of " + model.name() + ": the run has no valid segment");
+  const double rate = run.announcement.sample_rate_hz;
+  const int odmf = run.announcement.preprocessing.odmf;
+  FitOptions fit_options = options.fit;
+  fit_options.series = false;
+  const detail::FoldedRows base = detail::fold_rows(model, effects, segments, rate, odmf, fit_options, true);
+  const Eigen::VectorXd x = detail::evaluate(base, {}, {}).x;
+  const GridResiduals r0 = residuals_at(base, x);
+  const detail::RowSelection rows = detail::kept_rows(model, effects, segments, odmf);
+  // One channel at a time: the floor is the sum of the channels' shares, and each share's
+  // uncertainty (its sigma's, measured) is carried on its own. A channel the model does not
+  // read leaves the residual exactly unchanged at the first draw and gets no more.
+  std::vector<std::vector<LagSums>> shares;  // [channel][group]
+  std::vector<double> share_relative_variance;
+  std::mt19937_64 rng(options.seed);
+  for (const ChannelNoise& c : noise) {
+    const Eigen::Index column = column_of(run.announcement, c.channel);
+    if (column < 0 || !(c.sigma > 0.0)) continue;
+    std::vector<LagSums> sums(r0.size());
+    for (int d = 0; d < options.draws; ++d) {
+      const auto noisy = ingest::preprocess_offline(with_noise(run, column, c.sigma, rng));
+      const GridResiduals r1 =
+          residuals_at(detail::fold_rows(model, effects, noisy, rate, odmf, fit_options, true, &rows), x);
+      for (std::size_t g = 0; g < sums.size(); ++g) sums[g].add(difference(r1[g], r0[g]), odmf);
+      if (d == 0 && std::all_of(sums.begin(), sums.end(), [](const LagSums& l) { return l.square == 0.0; })) break;
+    }
+    if (std::all_of(sums.begin(), sums.end(), [](const LagSums& l) { return l.square == 0.0; })) continue;
+    shares.push_back(std::move(sums));
+    share_relative_variance.push_back(c.level_relative_variance);
+  }
+  NoiseFloor out;
+  out.channels = noise;
+  out.draws = options.draws;
+  const auto tested = static_cast<double>(std::count_if(r0.begin(), r0.end(), [](const auto& r) { return !r.empty(); }));
+  for (std::size_t g = 0; g < r0.size(); ++g) {
+    GroupFloor f;
+    f.group = base.groups[g];
+    f.rows = r0[g].size();
+    LagSums total;
+    double floor_variance = 0.0;  // of the floor's mean square, from the shares' sigmas
+    for (std::size_t c = 0; c < shares.size(); ++c) {
+      const LagSums& share = shares[c][g];
+      if (share.rows == 0) continue;
+      const double ms = share.square / static_cast<double>(share.rows);
+      floor_variance += ms * ms * share_relative_variance[c];
+      total.square += ms;
+      for (std::size_t k = 0; k < total.lagged.size(); ++k)
+        total.lagged[k] += share.lagged[k] / static_cast<double>(share.rows);
+      total.rows = std::max(total.rows, share.rows);
+    }
+    double ss = 0.0;
+    for (const auto& [grid, r] : r0[g]) ss += r * r;
+    const auto n = static_cast<double>(f.rows);
+    f.residual_rms = f.rows > 0 ? std::sqrt(ss / n) : 0.0;
+    if (f.rows == 0 || total.square <= 0.0) {  // no noise reaches the rows: only an exact fit is at the floor
+      f.at_floor = f.residual_rms <= std::numeric_limits<double>::epsilon() * (1.0 + std::sqrt(ss));
+      out.groups.push_back(f);
+      continue;
+    }
+    f.floor_rms = std::sqrt(total.square);
+    f.ratio = (f.residual_rms * f.residual_rms) / total.square;
+    f.effective_rows = std::max(1.0, total.effective_rows(n));
+    // log(ratio) under "the model lacks nothing": the residual's mean square is chi2(n_eff) /
+    // n_eff (variance 2 / n_eff), the floor's has the relative variance of its sigmas and of its
+    // draws (2 / (draws n_eff)).
+    f.floor_relative_std = std::sqrt(floor_variance / (total.square * total.square) +
+                                     2.0 / (options.draws * f.effective_rows));
+    const double sd = std::sqrt(2.0 / f.effective_rows + f.floor_relative_std * f.floor_relative_std);
+    const double z = boost::math::quantile(boost::math::normal(), 1.0 - options.error_rate / tested);
+    f.upper_ratio = std::exp(z * sd);
+    f.at_floor = f.ratio <= f.upper_ratio;
+    out.groups.push_back(f);
+  }
+  return out;
+}
+
+}  // namespace dynid::residual

@@ -1,0 +1,155 @@
+// The residual loop's judgement (residual/noise_floor.hpp, residual/diagnosis.hpp) on synthetic
+// runs whose noise is known: the channel noise read above the cut-off, the floor it makes
+// through a model's rows, the stated rate of false alarms, and the three verdicts.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "dynid/model/registry.hpp"
+#include "dynid/residual/diagnosis.hpp"
+
+namespace dynid::residual {
+namespace {
+
+constexpr double kRate = 100.0;
+constexpr double kG = 9.80665;
+
+// Units of the catalogue (docs/CHANNELS.md): models check them.
+std::string unit_of(const std::string& channel) { return channel == "ax" ? "m/s^2" : "m/s"; }
+
+ingest::RecordedRun recorded(const std::vector<std::pair<std::string, Eigen::VectorXd>>& channels) {
+  ingest::RecordedRun run;
+  run.announcement.vehicle = "synthetic";
+  run.announcement.run = "r";
+  run.announcement.sample_rate_hz = kRate;
+  const Eigen::Index n = channels.front().second.size();
+  run.samples.resize(n, static_cast<Eigen::Index>(channels.size()));
+  for (std::size_t j = 0; j < channels.size(); ++j) {
+    run.announcement.channels.push_back({channels[j].first, unit_of(channels[j].first)});
+    run.samples.col(static_cast<Eigen::Index>(j)) = channels[j].second;
+  }
+  run.valid.assign(static_cast<std::size_t>(n), 1);
+  return run;
+}
+
+double smooth(double t) { return 15.0 + 4.0 * std::sin(0.21 * t) + 1.5 * std::sin(0.9 * t + 0.3); }
+
+// Over 20 runs: the measured std is unbiased, and the relative variance the bootstrap reports
+// for sigma^2 is the scatter the runs show (within a factor 2).
+TEST(ChannelNoise, ReadsTheStdOfWhiteNoiseUnderASlowSignalAndItsUncertainty) {
+  constexpr int kRuns = 20;
+  double sum = 0.0, square = 0.0, reported = 0.0;
+  for (int seed = 0; seed < kRuns; ++seed) {
+    std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+    std::normal_distribution<double> n01;
+    Eigen::VectorXd x(6000);
+    for (Eigen::Index k = 0; k < x.size(); ++k) x(k) = smooth(static_cast<double>(k) / kRate) + 0.05 * n01(rng);
+    const auto noise = measure_channel_noise(recorded({{"vx", x}}));
+    ASSERT_EQ(noise.size(), 1U);
+    EXPECT_EQ(noise[0].source, "measured above the cut-off");
+    const double s2 = noise[0].sigma * noise[0].sigma;
+    sum += s2;
+    square += s2 * s2;
+    reported += noise[0].level_relative_variance;
+  }
+  const double mean = sum / kRuns;
+  const double scatter = (square / kRuns - mean * mean) / (mean * mean);
+  EXPECT_NEAR(std::sqrt(mean), 0.05, 0.0025);
+  EXPECT_GT(reported / kRuns, scatter / 2.0);
+  EXPECT_LT(reported / kRuns, scatter * 2.0);
+}
+
+TEST(ChannelNoise, ADeclaredStdReplacesTheMeasurement) {
+  Eigen::VectorXd x(3000);
+  for (Eigen::Index k = 0; k < x.size(); ++k) x(k) = smooth(static_cast<double>(k) / kRate);
+  const auto declared = measure_channel_noise(recorded({{"vx", x}}), {{"vx", 0.2}});
+  EXPECT_EQ(declared[0].sigma, 0.2);
+  EXPECT_EQ(declared[0].source, "declared");
+}
+
+// A message at 25 Hz, interpolated linearly onto the 100 Hz grid: its noise (std s per message)
+// lies mostly below 12.5 Hz. The in-band level is the 25 Hz white level, s^2 / 12.5 per Hz, so
+// its white equivalent at 100 Hz is s^2 / 12.5 * 50 = (2 s)^2; the power above the cut-off,
+// spread flat, would read about half of that.
+TEST(ChannelNoise, ReadsTheInBandNoiseOfAChannelInterpolatedFromASlowerMessage) {
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> n01;
+  const Eigen::Index n = 12000;
+  std::vector<double> message;
+  for (Eigen::Index m = 0; m <= n / 4; ++m) message.push_back(smooth(static_cast<double>(4 * m) / kRate) + 0.05 * n01(rng));
+  Eigen::VectorXd x(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const auto m = static_cast<std::size_t>(k / 4);
+    const double f = static_cast<double>(k % 4) / 4.0;
+    x(k) = (1.0 - f) * message[m] + f * message[m + 1];
+  }
+  const auto noise = measure_channel_noise(recorded({{"vx", x}}));
+  EXPECT_NEAR(noise[0].sigma, 0.10, 0.015);
+}
+
+// The kinematic model ax = s d_vx + o on a run whose only flaw is sensor noise: the residual is
+// at the floor; the same run on a hilly road (no grade channel) is not.
+ingest::RecordedRun kinematic_run(std::uint64_t seed, double grade_amplitude) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01;
+  const Eigen::Index n = 6000;
+  Eigen::VectorXd vx(n), ax(n);
+  double s = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / kRate;
+    const double dv = 4.0 * 0.21 * std::cos(0.21 * t) + 1.5 * 0.9 * std::cos(0.9 * t + 0.3);
+    s += smooth(t) / kRate;
+    const double grade = grade_amplitude * std::sin(s / 90.0);
+    vx(k) = smooth(t) + 0.02 * n01(rng);
+    ax(k) = 1.02 * dv + 0.15 + kG * std::sin(grade) + 0.05 * n01(rng);
+  }
+  return recorded({{"vx", vx}, {"ax", ax}});
+}
+
+TEST(NoiseFloor, AModelThatLacksNothingIsAdequateAtTheStatedRate) {
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  int adequate = 0;
+  double ratios = 0.0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const Diagnosis d = diagnose(*model, {}, kinematic_run(seed, 0.0));
+    ASSERT_EQ(d.floor.groups.size(), 1U);
+    ratios += d.floor.groups[0].ratio;
+    if (d.verdict == Verdict::kAdequate) ++adequate;
+    else std::printf("seed %llu: %s\n", static_cast<unsigned long long>(seed), d.statement().c_str());
+  }
+  EXPECT_NEAR(ratios / 20.0, 1.0, 0.1);  // the floor is the residual's own level, unbiased
+  EXPECT_GE(adequate, 18);  // 5 % false alarms: 1 expected in 20
+}
+
+TEST(Diagnosis, AnUnmeasuredGradeIsAboveTheFloorAndTracedToTheRoadProfile) {
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  const Diagnosis d = diagnose(*model, {}, kinematic_run(7, 0.04));
+  std::printf("%s\n", d.statement().c_str());
+  EXPECT_GT(d.floor.groups[0].ratio, 3.0);
+  ASSERT_EQ(d.verdict, Verdict::kExplained) << d.statement();
+  EXPECT_EQ(d.accepted->effect, "road_grade_profile");
+}
+
+// Structure no candidate can express: a residual that follows the run's time (a sensor drifting
+// over the run) with the dictionary and the road profile switched off.
+TEST(Diagnosis, StructureNoCandidateExplainsIsSaidWithItsSignature) {
+  auto run = kinematic_run(9, 0.0);
+  for (Eigen::Index k = 0; k < run.samples.rows(); ++k) run.samples(k, 1) += 0.4 * static_cast<double>(k) / 6000.0;
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  DiagnosisOptions options;
+  options.screen.dictionary = false;
+  options.screen.road_profile = false;
+  const Diagnosis d = diagnose(*model, {}, run, options);
+  std::printf("%s\n", d.statement().c_str());
+  ASSERT_EQ(d.verdict, Verdict::kStructureLeft) << d.statement();
+  ASSERT_FALSE(d.signature.correlations.empty());
+  const auto time = std::find_if(d.signature.correlations.begin(), d.signature.correlations.end(),
+                                 [](const CorrelationFinding& f) { return f.channel == "time"; });
+  ASSERT_NE(time, d.signature.correlations.end()) << "the drift's signature is its correlation with time";
+  EXPECT_GT(time->correlation, 0.0);
+}
+
+}  // namespace
+}  // namespace dynid::residual
