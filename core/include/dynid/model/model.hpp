@@ -22,11 +22,32 @@
 
 namespace dynid::model {
 
+/// One parameter of a model or of an effect.
+///
+/// Bounds: what physics allows at all, not a prior. A value outside them is impossible for the
+/// quantity the parameter names (a negative mass, a drag area of 5 m^2 on a car, a negative
+/// damper): an estimate there says the data or the model is wrong, never that the car is
+/// unusual. So bounds are wide ("> 0", "(0, 2]") and absent where the sign is not fixed by
+/// physics (offsets, gains of either sign, dictionary terms, road-profile knots).
+/// lower_inclusive / upper_inclusive say whether the bound itself is allowed; the defaults are
+/// the common case, a strict lower bound and an inclusive upper one: mass > 0, an efficiency in
+/// (0, 1]; damping >= 0 sets lower_inclusive. Per-unit-mass variants (lateral_bicycle without
+/// a mass) keep the sign bounds only. The bounds are of the parameter as named, in its unit.
 struct ParameterInfo {
   std::string name;         ///< e.g. "mass", unique within the model and its effects
   std::string unit;         ///< SI, e.g. "kg", "N/rad", "kg m^2"
   std::string description;
   std::optional<double> a_priori;  ///< a known or nominal value, if any
+  std::optional<double> lower = std::nullopt;  ///< physical lower bound, if any
+  std::optional<double> upper = std::nullopt;  ///< physical upper bound, if any
+  bool lower_inclusive = false;  ///< value == lower allowed (">= 0"); default strict ("> 0")
+  bool upper_inclusive = true;   ///< value == upper allowed ("<= 2"); default inclusive
+
+  /// True when `value` is within the bounds, and for NaN: a parameter that is not identifiable
+  /// (NaN estimate) is not out of bounds. +-Inf is out of any bound on its side.
+  bool within_bounds(double value) const;
+  /// The bounds in one line for reports: "> 0", ">= 0", "<= 0", "(0, 2]"; "" when none.
+  std::string bounds_text() const;
 };
 
 struct ChannelNeed {
