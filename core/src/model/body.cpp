@@ -8,6 +8,7 @@
 namespace dynid::model {
 
 using detail::parameter;
+using detail::positive;
 
 namespace {
 
@@ -50,16 +51,18 @@ std::vector<std::string> BodyModel::measured_side() const {
 }
 
 std::vector<ParameterInfo> BodyModel::parameters() const {
-  return {parameter("XX", "kg m^2", "roll inertia at C"),
+  // Moments of inertia and the mass > 0; products of inertia and first moments take either
+  // sign (they depend on where C and the axes are), so they have no bounds.
+  return {positive(parameter("XX", "kg m^2", "roll inertia at C")),
           parameter("XY", "kg m^2", "inertia product at C"),
           parameter("XZ", "kg m^2", "inertia product at C"),
-          parameter("YY", "kg m^2", "pitch inertia at C"),
+          positive(parameter("YY", "kg m^2", "pitch inertia at C")),
           parameter("YZ", "kg m^2", "inertia product at C"),
-          parameter("ZZ", "kg m^2", "yaw inertia at C"),
+          positive(parameter("ZZ", "kg m^2", "yaw inertia at C")),
           parameter("MX", "kg m", "longitudinal first moment M x_G"),
           parameter("MY", "kg m", "lateral first moment M y_G"),
           parameter("MZ", "kg m", "vertical first moment M z_G"),
-          parameter("M", "kg", "mass")};
+          positive(parameter("M", "kg", "mass"))};
 }
 
 std::vector<ChannelNeed> BodyModel::channels() const {
@@ -105,7 +108,7 @@ std::vector<RowModel::EffectDefinition> BodyModel::effect_definitions() const {
   const double half_rho = 0.5 * *air_density_;
   out.push_back(detail::one_column(
       {effect::kAeroDrag, "aerodynamic drag 1/2 rho SCx vx|vx| in the fx equation",
-       {parameter("SCx", "m^2", "drag area")},
+       {detail::drag_area("drag area")},
        {"vx"}},
       [half_rho](const ChannelSet& set) -> detail::ValueFn {
         const Eigen::VectorXd& vx = set["vx"];

@@ -10,6 +10,7 @@
 namespace dynid::model {
 
 using detail::parameter;
+using detail::positive;
 
 ClutchSlipModel::ClutchSlipModel(const Constants& constants) {
   const ConstantReader c(constants, name());
@@ -58,8 +59,9 @@ std::function<double(double)> ClutchSlipModel::clamp_load() const {
 }
 
 std::vector<ParameterInfo> ClutchSlipModel::parameters() const {
-  return {parameter("engine_inertia", "kg m^2", "engine and flywheel inertia J_e"),
-          parameter("coulomb_friction", "-", "Coulomb friction coefficient mu_c")};
+  return {positive(parameter("engine_inertia", "kg m^2", "engine and flywheel inertia J_e")),
+          detail::bounded(parameter("coulomb_friction", "-", "Coulomb friction coefficient mu_c"),
+                          0.0, 2.0)};
 }
 
 std::vector<ChannelNeed> ClutchSlipModel::channels() const {
@@ -85,7 +87,10 @@ RowModel::EffectDefinition ClutchSlipModel::friction_effect(Effect info,
 
 std::vector<RowModel::EffectDefinition> ClutchSlipModel::effect_definitions() const {
   std::vector<EffectDefinition> out{
-      friction_effect({effect::kViscous, "viscous friction Gamma_n mu_v dw",
+      friction_effect({effect::kViscous,
+                       "viscous friction Gamma_n mu_v dw",
+                       // No bound: a facing's mu may fall with slip speed (the cause of
+                       // judder), a negative mu_v over the slips of a launch.
                        {parameter("viscous_friction", "s/rad", "mu_v")},
                        {}},
                       [](double slip) { return slip; }),
@@ -101,6 +106,8 @@ std::vector<RowModel::EffectDefinition> ClutchSlipModel::effect_definitions() co
       {effect::kStribeck,
        "Stribeck friction Gamma_n (mu_s - mu_c) exp(-(dw/v_s)^2) sgn dw, v_s = " +
            std::to_string(vs) + " rad/s",
+       // No bound: mu_s > mu_c for most pairs, but clutch facings are made with mu rising
+       // with slip (anti-judder), mu_s - mu_c < 0.
        {parameter("stribeck_friction", "-", "mu_s - mu_c")},
        {}},
       [vs](double slip) { return std::exp(-(slip / vs) * (slip / vs)) * detail::sgn(slip); }));

@@ -8,6 +8,7 @@
 namespace dynid::model {
 
 using detail::parameter;
+using detail::positive;
 
 KinematicModel::KinematicModel(const Constants& constants, Axis axis) : axis_(axis) {
   gravity_ = ConstantReader(constants, name()).positive_or("gravity", detail::kStandardGravity);
@@ -26,7 +27,9 @@ std::vector<std::string> KinematicModel::measured_side() const {
 }
 
 std::vector<ParameterInfo> KinematicModel::parameters() const {
-  return {parameter("sensor_scale", "-", "accelerometer gain over speed scale", 1.0),
+  // The scale is a ratio of two gains near 1 (> 0: a negative one is a sensor mounted the
+  // wrong way round or a sign error in the profile, not a car); the offset has either sign.
+  return {positive(parameter("sensor_scale", "-", "accelerometer gain over speed scale", 1.0)),
           parameter("sensor_offset", "m/s^2", "accelerometer offset", 0.0)};
 }
 
@@ -48,7 +51,9 @@ std::vector<RowModel::EffectDefinition> KinematicModel::effect_definitions() con
   std::vector<EffectDefinition> out{detail::one_column(
       {lon ? effect::kRoadGrade : effect::kRoadBank,
        "gravity along the axis: g sin(" + channel + ")",
-       {parameter(lon ? "grade_gain" : "bank_gain", "-", "gain on g sin(angle)", 1.0)},
+       // > 0: the accelerometer reads +g sin(grade) (grade positive uphill) and +g sin(bank)
+       // (bank positive raising the left side), times its own gain near 1.
+       {positive(parameter(lon ? "grade_gain" : "bank_gain", "-", "gain on g sin(angle)", 1.0))},
        {channel}},
       [channel, g](const ChannelSet& set) -> detail::ValueFn {
         const Eigen::VectorXd& angle = set[channel];
@@ -56,8 +61,10 @@ std::vector<RowModel::EffectDefinition> KinematicModel::effect_definitions() con
       })};
   if (!lon)
     out.push_back(detail::one_column(
-        {effect::kRollGravity, "the accelerometer rolls with the body: g sin(roll) more",
-         {parameter("roll_gravity_gain", "-", "gain on g sin(roll)", 1.0)},
+        {effect::kRollGravity,
+         "the accelerometer rolls with the body: g sin(roll) more",
+         // > 0: roll positive right side down tilts the y axis to read +g sin(roll).
+         {positive(parameter("roll_gravity_gain", "-", "gain on g sin(roll)", 1.0))},
          {"roll"}},
         [g](const ChannelSet& set) -> detail::ValueFn {
           const Eigen::VectorXd& roll = set["roll"];

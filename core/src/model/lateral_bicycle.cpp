@@ -8,6 +8,7 @@
 namespace dynid::model {
 
 using detail::parameter;
+using detail::positive;
 
 LateralBicycleModel::LateralBicycleModel(const Constants& constants) {
   const ConstantReader c(constants, name());
@@ -25,13 +26,19 @@ ParameterInfo LateralBicycleModel::scaled(ParameterInfo p) const {
   p.name += "_per_mass";
   p.unit += "/kg";
   p.description += ", per unit mass";
+  // Dividing by an unknown M > 0 keeps a sign bound (0) and loses any other.
+  if (p.lower && *p.lower != 0.0) p.lower.reset();
+  if (p.upper && *p.upper != 0.0) p.upper.reset();
   return p;
 }
 
 std::vector<ParameterInfo> LateralBicycleModel::parameters() const {
-  return {scaled(parameter("yaw_inertia", "kg m^2", "yaw inertia at the CG")),
-          scaled(parameter("front_cornering_stiffness", "N/rad", "front axle (both tyres)")),
-          scaled(parameter("rear_cornering_stiffness", "N/rad", "rear axle (both tyres)"))};
+  // C_f, C_r > 0 in this sign convention: the slip angles d_f = steer - atan(..) and d_r are
+  // those that give a positive (leftward) force, F_y = C d.
+  return {
+      scaled(positive(parameter("yaw_inertia", "kg m^2", "yaw inertia at the CG"))),
+      scaled(positive(parameter("front_cornering_stiffness", "N/rad", "front axle (both tyres)"))),
+      scaled(positive(parameter("rear_cornering_stiffness", "N/rad", "rear axle (both tyres)")))};
 }
 
 std::vector<ChannelNeed> LateralBicycleModel::channels() const {
@@ -98,14 +105,20 @@ std::vector<RowModel::EffectDefinition> LateralBicycleModel::effect_definitions(
                       [](double) { return 1.0; }, true),
           axle_effect({effect::kTyreSaturation,
                        "Fiala tyre before saturation: F_y = C d - C^2/(3 mu F_z) |d| d",
-                       {scaled(parameter("front_tyre_saturation", "N/rad^2", "|d| d coefficient")),
-                        scaled(parameter("rear_tyre_saturation", "N/rad^2", "|d| d coefficient"))},
+                       // -C^2/(3 mu F_z) <= 0: a tyre's force grows less than linearly with
+                       // slip before it saturates, never more.
+                       {scaled(detail::non_positive(
+                            parameter("front_tyre_saturation", "N/rad^2", "|d| d coefficient"))),
+                        scaled(detail::non_positive(
+                            parameter("rear_tyre_saturation", "N/rad^2", "|d| d coefficient")))},
                        {}},
                       detail::signed_square, true),
           roll_acceleration()};
 }
 
 RowModel::EffectDefinition LateralBicycleModel::roll_acceleration() const {
+  // No bounds: m_r h_r changes sign with the IMU above or below the roll axis, J_xz with the
+  // tilt of the principal axes.
   EffectDefinition def{{effect::kRollAcceleration,
                         "roll acceleration of the body: lateral m_r h_r d2phi/dt2 (masses that do not roll "
                         "with the body, IMU above or below the rolling CG), yaw J_xz d2phi/dt2",

@@ -8,7 +8,9 @@
 
 namespace dynid::model {
 
+using detail::non_negative;
 using detail::parameter;
+using detail::positive;
 
 LockedDrivelineModel::LockedDrivelineModel(const Constants& constants) {
   const ConstantReader c(constants, "locked_driveline");
@@ -22,10 +24,13 @@ LockedDrivelineModel::LockedDrivelineModel(const Constants& constants) {
 }
 
 std::vector<ParameterInfo> LockedDrivelineModel::parameters() const {
-  return {parameter("equivalent_inertia", "kg m^2", "J_e + J_bv at the engine shaft"),
-          parameter("road_load_constant", "N m", "p: rolling resistance at the engine shaft"),
-          parameter("road_load_linear", "N m s/rad", "q"),
-          parameter("road_load_quadratic", "N m s^2/rad^2", "r: aerodynamic drag")};
+  // The road load only takes energy: p, q, r >= 0 (a negative p says that an ECU torque
+  // offset, the same column, is in the data).
+  return {positive(parameter("equivalent_inertia", "kg m^2", "J_e + J_bv at the engine shaft")),
+          non_negative(
+              parameter("road_load_constant", "N m", "p: rolling resistance at the engine shaft")),
+          non_negative(parameter("road_load_linear", "N m s/rad", "q")),
+          non_negative(parameter("road_load_quadratic", "N m s^2/rad^2", "r: aerodynamic drag"))};
 }
 
 std::vector<ChannelNeed> LockedDrivelineModel::channels() const {
@@ -39,14 +44,15 @@ std::vector<ChannelNeed> LockedDrivelineModel::channels() const {
 }
 
 std::vector<RowModel::EffectDefinition> LockedDrivelineModel::effect_definitions() const {
-  return {detail::one_column(
-              {effect::kRoadGrade, "grade torque (M g r_w / alpha) sin(grade)",
-               {parameter("grade_torque", "N m", "M g r_w / alpha")},
-               {"road_grade"}},
-              [](const ChannelSet& set) -> detail::ValueFn {
-                const Eigen::VectorXd& grade = set["road_grade"];
-                return [&grade](Eigen::Index k) { return std::sin(grade(k)); };
-              }),
+  return {detail::one_column({effect::kRoadGrade,
+                              "grade torque (M g r_w / alpha) sin(grade)",
+                              // > 0 with road_grade positive uphill (docs/CHANNELS.md).
+                              {positive(parameter("grade_torque", "N m", "M g r_w / alpha"))},
+                              {"road_grade"}},
+                             [](const ChannelSet& set) -> detail::ValueFn {
+                               const Eigen::VectorXd& grade = set["road_grade"];
+                               return [&grade](Eigen::Index k) { return std::sin(grade(k)); };
+                             }),
           detail::brake_drag("brake_torque_gain", "N m/Pa")};
 }
 

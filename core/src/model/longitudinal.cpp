@@ -8,7 +8,9 @@
 
 namespace dynid::model {
 
+using detail::non_negative;
 using detail::parameter;
+using detail::positive;
 
 LongitudinalModel::LongitudinalModel(const Constants& constants, Source source) : source_(source) {
   const ConstantReader c(constants, name());
@@ -35,9 +37,12 @@ std::vector<std::string> LongitudinalModel::measured_side() const {
 }
 
 std::vector<ParameterInfo> LongitudinalModel::parameters() const {
-  return {parameter("mass", "kg", "vehicle mass (translating)"),
-          parameter("SCx", "m^2", "aerodynamic drag area S Cx"),
-          parameter("rolling_resistance", "N", "rolling resistance force F_r = C_rr M g")};
+  // F_r >= 0: rolling resistance only takes energy (a negative one says that a torque offset,
+  // the same column within a gear, is left in the data).
+  return {positive(parameter("mass", "kg", "vehicle mass (translating)")),
+          detail::drag_area("aerodynamic drag area S Cx"),
+          non_negative(
+              parameter("rolling_resistance", "N", "rolling resistance force F_r = C_rr M g"))};
 }
 
 std::vector<ChannelNeed> LongitudinalModel::channels() const {
@@ -80,8 +85,11 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
   const double g = gravity_;
   std::vector<EffectDefinition> out{
       detail::one_column(
-          {effect::kRoadGrade, "grade load M g sin(grade) from the road_grade channel",
-           {parameter("grade_mass", "kg", "mass seen by the grade (= mass if grade explains it)")},
+          {effect::kRoadGrade,
+           "grade load M g sin(grade) from the road_grade channel",
+           // A mass: > 0 with road_grade positive uphill (docs/CHANNELS.md).
+           {positive(parameter("grade_mass", "kg",
+                               "mass seen by the grade (= mass if grade explains it)"))},
            {"road_grade"}},
           [g](const ChannelSet& set) -> detail::ValueFn {
             const Eigen::VectorXd& grade = set["road_grade"];
@@ -90,17 +98,19 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
       detail::one_column(
           {effect::kRoadGradeAccelerometer,
            "grade load M (ax - d_vx): the accelerometer sees g sin(grade), the wheels do not",
-           {parameter("grade_mass_accelerometer", "kg", "mass seen by the grade")},
+           {positive(parameter("grade_mass_accelerometer", "kg", "mass seen by the grade"))},
            {"ax"}},
           [](const ChannelSet& set) -> detail::ValueFn {
             const Eigen::VectorXd& ax = set["ax"];
             const Eigen::VectorXd& dvx = set["d_vx"];
             return [&ax, &dvx](Eigen::Index k) { return ax(k) - dvx(k); };
           }),
-      detail::one_column({effect::kLinearDrag, "resistance proportional to speed (tyre losses)",
-                          {parameter("linear_drag", "N s/m", "speed-proportional resistance")},
-                          {}},
-                         [](const ChannelSet& set) { return detail::channel(set, "vx"); }),
+      detail::one_column(
+          {effect::kLinearDrag,
+           "resistance proportional to speed (tyre losses)",
+           {non_negative(parameter("linear_drag", "N s/m", "speed-proportional resistance"))},
+           {}},
+          [](const ChannelSet& set) { return detail::channel(set, "vx"); }),
       detail::brake_drag("brake_force_gain", "N/Pa")};
   if (source_ != Source::kEngineTorque) return out;
   auto factor = [this](const ChannelSet& set) { return drive(set); };
@@ -113,8 +123,9 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
       }));
   const double r = wheel_radius_;
   out.push_back(detail::one_column(
-      {effect::kRotatingInertia, "engine inertia through the gear: eta J_e G^2 / r_w^2 d_vx",
-       {parameter("engine_inertia", "kg m^2", "rotating inertia on the engine side")},
+      {effect::kRotatingInertia,
+       "engine inertia through the gear: eta J_e G^2 / r_w^2 d_vx",
+       {positive(parameter("engine_inertia", "kg m^2", "rotating inertia on the engine side"))},
        {}},
       [factor, r](const ChannelSet& set) -> detail::ValueFn {
         const Eigen::VectorXd& ratio = set["gear_ratio"];

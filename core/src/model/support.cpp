@@ -33,8 +33,11 @@ ValueFn channel(const ChannelSet& set, const std::string& name) {
 }
 
 RowModel::EffectDefinition brake_drag(const std::string& parameter_name, const std::string& unit) {
-  return one_column({"brake_drag", "brake force or torque proportional to brake pressure",
-                     {parameter(parameter_name, unit, "brake gain")}, {"brake_pressure"}},
+  return one_column({"brake_drag",
+                     "brake force or torque proportional to brake pressure",
+                     // >= 0: the brake resists (the column is on the resisting side).
+                     {non_negative(parameter(parameter_name, unit, "brake gain"))},
+                     {"brake_pressure"}},
                     [](const ChannelSet& set) { return channel(set, "brake_pressure"); });
 }
 

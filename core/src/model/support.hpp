@@ -29,10 +29,46 @@ using ValueFn = std::function<double(Eigen::Index k)>;
 RowModel::EffectDefinition one_column(Effect info, std::function<ValueFn(const ChannelSet&)> bind,
                                       std::size_t group = 0);
 
-/// One parameter description (a-priori value optional).
+/// One parameter description (a-priori value optional), no bounds: offsets, gains of either
+/// sign, terms whose sign physics does not fix.
 inline ParameterInfo parameter(std::string name, std::string unit, std::string description,
                                std::optional<double> a_priori = std::nullopt) {
   return {std::move(name), std::move(unit), std::move(description), a_priori};
+}
+
+// Physical bounds (ParameterInfo: impossibilities, not priors), put on a parameter():
+// positive(parameter("mass", "kg", "vehicle mass")).
+
+/// > 0: masses, inertias, stiffnesses, a sensor scale.
+inline ParameterInfo positive(ParameterInfo p) {
+  p.lower = 0.0;
+  return p;
+}
+
+/// >= 0: dissipative terms that may be absent (damping, dry friction, a brake gain).
+inline ParameterInfo non_negative(ParameterInfo p) {
+  p.lower = 0.0;
+  p.lower_inclusive = true;
+  return p;
+}
+
+/// <= 0: a term that can only take away (a tyre's saturation).
+inline ParameterInfo non_positive(ParameterInfo p) {
+  p.upper = 0.0;
+  return p;
+}
+
+/// In (lower, upper]: a friction coefficient (0, 2], a car's drag area (0, 2] m^2.
+inline ParameterInfo bounded(ParameterInfo p, double lower, double upper) {
+  p.lower = lower;
+  p.upper = upper;
+  return p;
+}
+
+/// A car's drag area S Cx (m^2): > 0, and <= 2 m^2 (a large van is ~1.2 m^2; Cx ~0.3..0.4
+/// over a frontal area of 2..3.5 m^2).
+inline ParameterInfo drag_area(std::string description) {
+  return bounded(parameter("SCx", "m^2", std::move(description)), 0.0, 2.0);
 }
 
 }  // namespace dynid::model::detail

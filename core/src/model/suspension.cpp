@@ -7,7 +7,9 @@
 
 namespace dynid::model {
 
+using detail::non_negative;
 using detail::parameter;
+using detail::positive;
 
 SuspensionModel::SuspensionModel(const Constants& constants, const std::string& corner)
     : corner_(corner), opposite_(detail::opposite_corner(corner, "suspension_" + corner)) {
@@ -15,9 +17,11 @@ SuspensionModel::SuspensionModel(const Constants& constants, const std::string& 
 }
 
 std::vector<ParameterInfo> SuspensionModel::parameters() const {
-  return {parameter("stiffness", "N/m", "spring stiffness k"),
-          parameter("damping", "N s/m", "damper coefficient h"),
-          parameter("dry_friction", "N", "Coulomb friction f_s"),
+  // Travel and force both positive in compression: k > 0, h >= 0 and f_s >= 0 (a damper and
+  // a friction only dissipate); the offset -k z0 has either sign.
+  return {positive(parameter("stiffness", "N/m", "spring stiffness k")),
+          non_negative(parameter("damping", "N s/m", "damper coefficient h")),
+          non_negative(parameter("dry_friction", "N", "Coulomb friction f_s")),
           parameter("force_offset", "N", "-k z0 (preload, travel sensor offset)")};
 }
 
@@ -32,29 +36,36 @@ std::vector<RowModel::EffectDefinition> SuspensionModel::effect_definitions() co
   const std::string travel = "susp_travel_" + corner_;
   const std::string other = "susp_travel_" + opposite_;
   const std::string speed = "d_susp_travel_" + corner_;
-  return {
-      detail::one_column({effect::kAntiRollBar, "anti-roll bar k_ar (z - z_opposite)",
-                          {parameter("anti_roll_bar_stiffness", "N/m", "k_ar, venture L864")},
-                          {other}},
-                         [travel, other](const ChannelSet& set) -> detail::ValueFn {
-                           const Eigen::VectorXd& z = set[travel];
-                           const Eigen::VectorXd& zo = set[other];
-                           return [&z, &zo](Eigen::Index k) { return z(k) - zo(k); };
-                         }),
-      detail::one_column({effect::kNonlinearDamping, "quadratic damping |dz/dt| dz/dt",
-                          {parameter("quadratic_damping", "N s^2/m^2", "")},
-                          {}},
-                         [speed](const ChannelSet& set) -> detail::ValueFn {
-                           const Eigen::VectorXd& v = set[speed];
-                           return [&v](Eigen::Index k) { return detail::signed_square(v(k)); };
-                         }),
-      detail::one_column({effect::kProgressiveStiffness, "progressive spring (bump stop) z^3",
-                          {parameter("cubic_stiffness", "N/m^3", "")},
-                          {}},
-                         [travel](const ChannelSet& set) -> detail::ValueFn {
-                           const Eigen::VectorXd& z = set[travel];
-                           return [&z](Eigen::Index k) { return z(k) * z(k) * z(k); };
-                         })};
+  return {detail::one_column(
+              {effect::kAntiRollBar,
+               "anti-roll bar k_ar (z - z_opposite)",
+               {non_negative(parameter("anti_roll_bar_stiffness", "N/m", "k_ar, venture L864"))},
+               {other}},
+              [travel, other](const ChannelSet& set) -> detail::ValueFn {
+                const Eigen::VectorXd& z = set[travel];
+                const Eigen::VectorXd& zo = set[other];
+                return [&z, &zo](Eigen::Index k) { return z(k) - zo(k); };
+              }),
+          detail::one_column({effect::kNonlinearDamping,
+                              "quadratic damping |dz/dt| dz/dt",
+                              // No bound: a digressive damper (blow-off valves) is h v with a
+                              // negative |v| v term, and it is common.
+                              {parameter("quadratic_damping", "N s^2/m^2", "")},
+                              {}},
+                             [speed](const ChannelSet& set) -> detail::ValueFn {
+                               const Eigen::VectorXd& v = set[speed];
+                               return [&v](Eigen::Index k) { return detail::signed_square(v(k)); };
+                             }),
+          detail::one_column({effect::kProgressiveStiffness,
+                              "progressive spring (bump stop) z^3",
+                              // No bound: a bump stop makes it positive, but a falling wheel
+                              // rate (linkage geometry) is a negative one and is not impossible.
+                              {parameter("cubic_stiffness", "N/m^3", "")},
+                              {}},
+                             [travel](const ChannelSet& set) -> detail::ValueFn {
+                               const Eigen::VectorXd& z = set[travel];
+                               return [&z](Eigen::Index k) { return z(k) * z(k) * z(k); };
+                             })};
 }
 
 RowModel::RowFn SuspensionModel::bind(const ChannelSet& set,

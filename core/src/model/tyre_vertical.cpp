@@ -5,7 +5,9 @@
 
 namespace dynid::model {
 
+using detail::non_negative;
 using detail::parameter;
+using detail::positive;
 
 TyreVerticalModel::TyreVerticalModel(const Constants&, const std::string& corner)
     : corner_(corner) {
@@ -13,7 +15,7 @@ TyreVerticalModel::TyreVerticalModel(const Constants&, const std::string& corner
 }
 
 std::vector<ParameterInfo> TyreVerticalModel::parameters() const {
-  return {parameter("vertical_stiffness", "N/m", "tyre vertical stiffness k_p"),
+  return {positive(parameter("vertical_stiffness", "N/m", "tyre vertical stiffness k_p")),
           parameter("force_offset", "N", "load at zero measured deflection (sensor offsets)")};
 }
 
@@ -26,17 +28,22 @@ std::vector<ChannelNeed> TyreVerticalModel::channels() const {
 std::vector<RowModel::EffectDefinition> TyreVerticalModel::effect_definitions() const {
   const std::string deflection = "tyre_deflection_" + corner_;
   const std::string speed = "d_tyre_deflection_" + corner_;
-  return {detail::one_column({effect::kTyreDamping, "tyre damping c_p dz_p/dt",
-                              {parameter("tyre_damping", "N s/m", "")},
-                              {speed}},
-                             [speed](const ChannelSet& set) { return detail::channel(set, speed); }),
-          detail::one_column({effect::kProgressiveStiffness, "progressive tyre stiffness z_p^2",
-                              {parameter("quadratic_stiffness", "N/m^2", "")},
-                              {}},
-                             [deflection](const ChannelSet& set) -> detail::ValueFn {
-                               const Eigen::VectorXd& z = set[deflection];
-                               return [&z](Eigen::Index k) { return z(k) * z(k); };
-                             })};
+  return {
+      detail::one_column({effect::kTyreDamping,
+                          "tyre damping c_p dz_p/dt",
+                          {non_negative(parameter("tyre_damping", "N s/m", ""))},
+                          {speed}},
+                         [speed](const ChannelSet& set) { return detail::channel(set, speed); }),
+      detail::one_column({effect::kProgressiveStiffness,
+                          "progressive tyre stiffness z_p^2",
+                          // No bound: a tyre's load-deflection curve is mildly
+                          // progressive or degressive with pressure and construction.
+                          {parameter("quadratic_stiffness", "N/m^2", "")},
+                          {}},
+                         [deflection](const ChannelSet& set) -> detail::ValueFn {
+                           const Eigen::VectorXd& z = set[deflection];
+                           return [&z](Eigen::Index k) { return z(k) * z(k); };
+                         })};
 }
 
 RowModel::RowFn TyreVerticalModel::bind(const ChannelSet& set,
