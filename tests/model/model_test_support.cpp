@@ -51,10 +51,15 @@ ls::ParameterStatus Identified::status(const std::string& name) const {
   return estimate.structure.status[index_of(names, name)];
 }
 
+const model::ParameterInfo& Identified::info(const std::string& name) const {
+  return parameters.at(index_of(names, name));
+}
+
 Identified identify(const model::Model& m, const model::ChannelSet& channels,
                     const std::vector<std::string>& effects) {
   Identified out;
-  for (const model::ParameterInfo& p : m.parameters_with(effects)) out.names.push_back(p.name);
+  out.parameters = m.parameters_with(effects);
+  for (const model::ParameterInfo& p : out.parameters) out.names.push_back(p.name);
   ls::Accumulator acc(static_cast<Eigen::Index>(out.names.size()));
   for (const model::GroupRows& g : m.rows(channels, effects)) {
     EXPECT_EQ(g.W.cols(), static_cast<Eigen::Index>(out.names.size())) << g.group;
@@ -68,6 +73,21 @@ Identified identify(const model::Model& m, const model::ChannelSet& channels,
 
 double relative_error(double estimate, double truth) {
   return std::abs(estimate - truth) / std::abs(truth);
+}
+
+void expect_within_bounds(const Identified& id, const std::map<std::string, double>& truth) {
+  for (const auto& [name, value] : truth) {
+    const model::ParameterInfo& p = id.info(name);
+    EXPECT_TRUE(p.within_bounds(value)) << name << " = " << value << " is outside " << p.bounds_text();
+  }
+}
+
+void expect_recovered(const Identified& id, const std::map<std::string, double>& truth,
+                      double tolerance) {
+  for (const auto& [name, value] : truth)
+    EXPECT_LT(relative_error(id.value(name), value), tolerance)
+        << name << ": " << id.value(name) << " vs " << value;
+  expect_within_bounds(id, truth);
 }
 
 }  // namespace dynid::test

@@ -49,11 +49,12 @@ TEST(Suspension, ExactRecoveryWithAntiRollBar) {
   const model::ChannelSet set = front_axle(true);
   for (const char* corner : {"suspension_fl", "suspension_fr"}) {
     const Identified id = identify(*model::make_model(corner, {}), set, {"anti_roll_bar"});
-    EXPECT_LT(relative_error(id.value("stiffness"), kStiffness), 1e-6) << corner;
-    EXPECT_LT(relative_error(id.value("damping"), kDamping), 1e-6) << corner;
-    EXPECT_LT(relative_error(id.value("dry_friction"), kFriction), 1e-6) << corner;
-    EXPECT_LT(relative_error(id.value("force_offset"), kPreload), 1e-6) << corner;
-    EXPECT_LT(relative_error(id.value("anti_roll_bar_stiffness"), kBar), 1e-6) << corner;
+    SCOPED_TRACE(corner);
+    expect_recovered(id, {{"stiffness", kStiffness},
+                          {"damping", kDamping},
+                          {"dry_friction", kFriction},
+                          {"force_offset", kPreload},
+                          {"anti_roll_bar_stiffness", kBar}});
   }
 }
 
@@ -114,9 +115,8 @@ TEST(TyreVertical, ExactRecoveryAndLiftOffMasked) {
   set.add("d_tyre_deflection_rl", "m/s", dz);
   set.add("tyre_force_z_rl", "N", f);
   const Identified id = identify(*model::make_model("tyre_rl", {}), set, {"tyre_damping"});
-  EXPECT_LT(relative_error(id.value("vertical_stiffness"), 200000.0), 1e-6);
-  EXPECT_LT(relative_error(id.value("force_offset"), 150.0), 1e-6);
-  EXPECT_LT(relative_error(id.value("tyre_damping"), 250.0), 1e-6);
+  expect_recovered(
+      id, {{"vertical_stiffness", 200000.0}, {"force_offset", 150.0}, {"tyre_damping", 250.0}});
   EXPECT_LT(id.rows, static_cast<std::size_t>(n));  // some samples are off the ground
 }
 

@@ -54,10 +54,10 @@ TEST(ClutchSlip, ExactRecoveryOfInertiaAndStribeckFriction) {
   const auto m = model::make_model(
       "clutch_slip", {{"clutch_friction_radius", kRadius}, {"stribeck_speed", kClio.speed}});
   const Identified id = identify(*m, set, {"viscous_friction", "stribeck_friction"});
-  EXPECT_LT(relative_error(id.value("engine_inertia"), kEngineInertia), 1e-6);
-  EXPECT_LT(relative_error(id.value("coulomb_friction"), kClio.coulomb), 1e-6);
-  EXPECT_LT(relative_error(id.value("stribeck_friction"), kClio.stribeck), 1e-6);
-  EXPECT_LT(relative_error(id.value("viscous_friction"), kClio.viscous), 1e-6);
+  expect_recovered(id, {{"engine_inertia", kEngineInertia},
+                        {"coulomb_friction", kClio.coulomb},
+                        {"stribeck_friction", kClio.stribeck},
+                        {"viscous_friction", kClio.viscous}});
   // Rows at slip ~ 0 are left out.
   const auto rows = m->rows(set);
   const Eigen::VectorXd slip = set["engine_speed"] - set["gearbox_input_speed"];
@@ -78,10 +78,10 @@ TEST(ClutchSlip, ClampLoadZeroFromTheTareIsSubtractedInEveryFrictionColumn) {
   zeroed["clutch_clamp_load_zero"] = f0;
   const Identified id =
       identify(*model::make_model("clutch_slip", zeroed), set, {"viscous_friction", "stribeck_friction"});
-  EXPECT_LT(relative_error(id.value("engine_inertia"), kEngineInertia), 1e-6);
-  EXPECT_LT(relative_error(id.value("coulomb_friction"), kClio.coulomb), 1e-6);
-  EXPECT_LT(relative_error(id.value("stribeck_friction"), kClio.stribeck), 1e-6);
-  EXPECT_LT(relative_error(id.value("viscous_friction"), kClio.viscous), 1e-6);
+  expect_recovered(id, {{"engine_inertia", kEngineInertia},
+                        {"coulomb_friction", kClio.coulomb},
+                        {"stribeck_friction", kClio.stribeck},
+                        {"viscous_friction", kClio.viscous}});
   // Without it the offset spoils the recovery.
   const Identified raw =
       identify(*model::make_model("clutch_slip", constants), set, {"viscous_friction", "stribeck_friction"});
@@ -107,9 +107,9 @@ TEST(ClutchSlip, OpenClampLoadTakesTheFrictionOutOfClutchOpenRows) {
       {"clutch_friction_radius", kRadius}, {"stribeck_speed", kClio.speed}, {"open_clamp_load", 100.0}};
   const Identified id =
       identify(*model::make_model("clutch_slip", constants), set, {"viscous_friction", "stribeck_friction"});
-  EXPECT_LT(relative_error(id.value("engine_inertia"), kEngineInertia), 1e-6);
-  EXPECT_LT(relative_error(id.value("coulomb_friction"), kClio.coulomb), 1e-6);
-  EXPECT_LT(relative_error(id.value("viscous_friction"), kClio.viscous), 1e-6);
+  expect_recovered(id, {{"engine_inertia", kEngineInertia},
+                        {"coulomb_friction", kClio.coulomb},
+                        {"viscous_friction", kClio.viscous}});
 }
 
 // A low-passed run smears what happens while the clutch sticks into the rows around it; with
@@ -133,9 +133,9 @@ TEST(ClutchSlip, StickMarginLeavesOutRowsNearAStuckSample) {
                                                    {"min_slip_speed", min_slip},
                                                    {"stick_margin", 0.1}});
   const Identified id = identify(*m, set, {"viscous_friction", "stribeck_friction"});
-  EXPECT_LT(relative_error(id.value("engine_inertia"), kEngineInertia), 1e-6);
-  EXPECT_LT(relative_error(id.value("coulomb_friction"), kClio.coulomb), 1e-6);
-  EXPECT_LT(relative_error(id.value("viscous_friction"), kClio.viscous), 1e-6);
+  expect_recovered(id, {{"engine_inertia", kEngineInertia},
+                        {"coulomb_friction", kClio.coulomb},
+                        {"viscous_friction", kClio.viscous}});
   // The mask reads the margin on both sides of a row: the reach says so (a streaming caller
   // keeps that much context), and never less than the default.
   const model::RowReach reach = m->reach(0.01);
@@ -205,6 +205,9 @@ TEST(ClutchSlip, BorsottoFrictionCaseCoulombViscousStribeck) {
   EXPECT_LT(relative_error(fc, 6.0), 1e-9);
   EXPECT_LT(relative_error(nm(stribeck.value("stribeck_friction")), 0.3), 1e-9);
   EXPECT_LT(relative_error(nm(stribeck.value("viscous_friction")), 0.1), 1e-9);
+  expect_within_bounds(stribeck, {{"coulomb_friction", kBorsotto.coulomb},
+                                  {"stribeck_friction", kBorsotto.stribeck},
+                                  {"viscous_friction", kBorsotto.viscous}});
 }
 
 TEST(StribeckSpeedBank, PicksBorsottoStribeckSpeedAmongCandidates) {
@@ -273,10 +276,11 @@ TEST(LockedDriveline, PerGearRecoveryOnlyFromThatGearsRows) {
     const auto m = model::make_model("locked_driveline", {{"gear", g.gear}});
     const Identified id = identify(*m, set);
     EXPECT_EQ(id.rows, static_cast<std::size_t>(n / 3 - (g.gear == 3 ? 2 : 1)));  // shift guard
-    EXPECT_LT(relative_error(id.value("equivalent_inertia"), g.inertia()), 1e-6) << g.gear;
-    EXPECT_LT(relative_error(id.value("road_load_constant"), g.p()), 1e-6) << g.gear;
-    EXPECT_LT(relative_error(id.value("road_load_linear"), g.q()), 1e-6) << g.gear;
-    EXPECT_LT(relative_error(id.value("road_load_quadratic"), g.r()), 1e-6) << g.gear;
+    SCOPED_TRACE(g.gear);
+    expect_recovered(id, {{"equivalent_inertia", g.inertia()},
+                          {"road_load_constant", g.p()},
+                          {"road_load_linear", g.q()},
+                          {"road_load_quadratic", g.r()}});
   }
 }
 

@@ -17,12 +17,6 @@ namespace {
 
 constexpr double kG = 9.80665;
 
-void expect_recovered(const Identified& id, const std::map<std::string, double>& truth) {
-  for (const auto& [name, value] : truth)
-    EXPECT_LT(relative_error(id.value(name), value), 1e-6)
-        << name << ": " << id.value(name) << " vs " << value;
-}
-
 // Longitudinal truth (a mid-size car: test data, not model code).
 constexpr double kMass = 1500.0, kSCx = 0.65, kRolling = 180.0, kRho = 1.2, kRadius = 0.31,
                  kEta = 0.92;
