@@ -1,6 +1,8 @@
 #include "dynid/server/request_parser.hpp"
 
+#include <cmath>
 #include <set>
+#include <stdexcept>
 
 #include "dynid/error.hpp"
 
@@ -24,7 +26,8 @@ const std::map<std::string, KindSpec>& kinds() {
       {"reprocess", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},
       {"base", {{"vehicle", "run", "model"}, {"format"}, {}}},
       {"residual", {{"vehicle", "run", "model"}, {"effects", "candidates", "format"}, {}}},
-      {"add-effect", {{"vehicle", "run", "model", "effect"}, {"effects", "format"}, {}}},
+      {"add-effect", {{"vehicle", "run", "model", "effect"}, {"effects", "reference", "format"}, {"reference"}}},
+      {"trace", {{"vehicle", "run", "model"}, {"effects", "reference", "rounds", "format"}, {"reference"}}},
       {"status", {{}, {"format"}, {}}},
       {"fleet", {{"model", "shared", "vehicles"}, {"format"}, {"shared"}}},
   };
@@ -75,10 +78,11 @@ ParsedRequest parse_request(const dds::Request& request) {
   for (const auto& name : spec->second.required)
     if (!parsed.arguments.count(name))
       throw InputError(where + ": '" + request.kind + "' needs argument '" + name + "'");
-  // The residual reports are for people: text or an HTML page, not JSON.
-  const bool report = request.kind == "residual" || request.kind == "add-effect";
-  if (const auto format = parsed.optional("format"); format && *format != "text" && *format != (report ? "html" : "json"))
-    throw InputError(where + ": format '" + *format + "' is neither text nor " + (report ? "html" : "json"));
+  // The residual loop's reports come as text, JSON or a self-contained HTML page.
+  const bool report = request.kind == "residual" || request.kind == "add-effect" || request.kind == "trace";
+  if (const auto format = parsed.optional("format");
+      format && *format != "text" && *format != "json" && !(report && *format == "html"))
+    throw InputError(where + ": format '" + *format + "' is neither text nor json" + (report ? " nor html" : ""));
   return parsed;
 }
 
@@ -93,6 +97,42 @@ std::vector<std::string> split_list(const std::string& text) {
     start = comma + 1;
   }
   return items;
+}
+
+std::map<std::string, double> parse_references(const std::vector<std::string>& arguments) {
+  std::map<std::string, double> out;
+  for (const std::string& a : arguments) {
+    const auto equals = a.find('=');
+    if (equals == std::string::npos || equals == 0)
+      throw InputError("reference '" + a + "': expected name=value, e.g. mass=1457.5");
+    const std::string name = a.substr(0, equals);
+    const std::string text = a.substr(equals + 1);
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != text.size() || !std::isfinite(value))
+      throw InputError("reference '" + a + "': '" + text + "' is not a finite number");
+    if (!out.emplace(name, value).second) throw InputError("reference '" + name + "' given twice");
+  }
+  return out;
+}
+
+int parse_rounds(const std::optional<std::string>& text) {
+  if (!text) return 4;
+  std::size_t used = 0;
+  int rounds = -1;
+  try {
+    rounds = std::stoi(*text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text->size() || rounds < 0 || rounds > 10)
+    throw InputError("rounds '" + *text + "': an integer from 0 to 10");
+  return rounds;
 }
 
 }  // namespace dynid::server

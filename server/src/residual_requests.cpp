@@ -6,7 +6,9 @@
 #include "dynid/report/residual_html.hpp"
 #include "dynid/report/residual_report.hpp"
 #include "dynid/residual/effect_comparison.hpp"
+#include "dynid/residual/diagnosis.hpp"
 #include "dynid/residual/effect_screen.hpp"
+#include "dynid/residual/trace.hpp"
 
 namespace dynid::server {
 namespace {
@@ -21,28 +23,60 @@ const ingest::ModelSpec& announced_model(const ingest::RunAnnouncement& a, const
 
 }  // namespace
 
+namespace {
+
+ResidualReply diagnosis_reply(const residual::Diagnosis& d, const std::string& title, const std::string& format) {
+  if (format == "json") return {report::diagnosis_json(d), "application/json"};
+  if (format == "html") return {report::residual_html({title, &d.screen, nullptr}), "text/html"};
+  return {report::format_diagnosis_text(d), "text/plain"};
+}
+
+ResidualReply trace_reply(const residual::Trace& t, const std::string& title, const std::string& format) {
+  if (format == "json") return {report::trace_json(t), "application/json"};
+  if (format == "html") {
+    const residual::TraceRound* last_added = nullptr;
+    for (const residual::TraceRound& r : t.rounds)
+      if (r.added) last_added = &r;
+    const residual::TraceRound& last = t.rounds.back();
+    return {report::residual_html({title + " (trace: " + t.stopped + ")", &last.diagnosis.screen,
+                                   last_added != nullptr ? &*last_added->added : nullptr}),
+            "text/html"};
+  }
+  return {report::format_trace_text(t), "text/plain"};
+}
+
+}  // namespace
+
 ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
                              const std::vector<ingest::Chunk>& chunks, const ResidualRequest& request) {
-  if (request.format != "text" && request.format != "html")
-    throw InputError("residual report: format '" + request.format + "' (text or html)");
+  if (request.format != "text" && request.format != "html" && request.format != "json")
+    throw InputError("residual report: format '" + request.format + "' (text, json or html)");
+  if (request.rounds < 0 || request.rounds > 10)
+    throw InputError("trace: rounds " + std::to_string(request.rounds) + " (0 to 10)");
   const ingest::ModelSpec& spec = announced_model(announcement, request.model);
   const std::vector<std::string> declared = request.effects.value_or(spec.effects);
   const auto model = model::make_model(spec.model, spec.constants);
-  const auto segments = ingest::preprocess_offline(ingest::assemble_run(announcement, chunks));
+  const ingest::RecordedRun run = ingest::assemble_run(announcement, chunks);
+  const auto segments = ingest::preprocess_offline(run);
   if (segments.empty())
     throw InputError("run " + announcement.vehicle + "/" + announcement.run + ": no valid segment long enough to filter");
   const double rate = announcement.sample_rate_hz;
   const int odmf = announcement.preprocessing.odmf;
   const std::string title = announcement.vehicle + " / " + announcement.run + " / " + spec.model;
+  if (request.kind == "trace") {
+    residual::TraceOptions options;
+    options.max_rounds = request.rounds;
+    options.reference = request.reference;
+    return trace_reply(residual::trace(*model, declared, run, options), title, request.format);
+  }
   if (request.effect.empty()) {
-    residual::ScreenOptions options;
-    options.only = request.candidates;
-    const residual::ScreenResult screen = residual::screen_effects(*model, declared, segments, rate, odmf, options);
-    if (request.format == "html") return {report::residual_html({title, &screen, nullptr}), "text/html"};
-    return {report::format_screen_text(screen), "text/plain"};
+    residual::DiagnosisOptions options;
+    options.screen.only = request.candidates;
+    return diagnosis_reply(residual::diagnose(*model, declared, run, options), title, request.format);
   }
   const residual::EffectComparison cmp =
-      residual::compare_effect(*model, declared, request.effect, segments, rate, odmf);
+      residual::compare_effect(*model, declared, request.effect, segments, rate, odmf, {}, request.reference);
+  if (request.format == "json") return {report::comparison_json(cmp), "application/json"};
   if (request.format == "html") return {report::residual_html({title, nullptr, &cmp}), "text/html"};
   return {report::format_comparison_text(cmp), "text/plain"};
 }

@@ -161,10 +161,12 @@ dds::Reply Server::Impl::execute(const ParsedRequest& r, RunService& service) {
                      r.json());
   } else if (r.kind == "base") {
     payload = service.base_report(vehicle, r.required("run"), r.required("model"), r.json());
-  } else if (r.kind == "residual" || r.kind == "add-effect") {
+  } else if (r.kind == "residual" || r.kind == "add-effect" || r.kind == "trace") {
     ResidualRequest request{r.required("model"), std::nullopt, split_list(r.optional("candidates").value_or("")),
-                            r.kind == "add-effect" ? r.required("effect") : "", r.optional("format").value_or("text")};
-    if (const auto effects = r.optional("effects")) request.effects = split_list(*effects);
+                            r.kind == "add-effect" ? r.required("effect") : "", r.optional("format").value_or("text"),
+                            r.kind, parse_references(r.all("reference")), parse_rounds(r.optional("rounds"))};
+    if (const auto effects = r.optional("effects"))  // "none": the model with no effect declared
+      request.effects = *effects == "none" ? std::vector<std::string>{} : split_list(*effects);
     ResidualReply reply = service.residual(vehicle, r.required("run"), request);
     return {{}, 0, dds::ReplyStatus::kOk, {}, reply.payload_format, std::move(reply.payload)};
   }

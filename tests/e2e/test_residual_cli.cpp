@@ -4,6 +4,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "e2e_fixture.hpp"
 
 namespace dynid::e2e {
@@ -52,10 +54,60 @@ TEST(E2eResidualCli, RanksEffectsAndWritesTheBeforeAfterReport) {
   const auto bad_effect = dynid(args);
   EXPECT_EQ(bad_effect.exit_code, 2);
   EXPECT_NE(bad_effect.err.find("warp_drive"), std::string::npos) << bad_effect.err;
-  const auto json = request("residual", {{"vehicle", "res-car"}, {"run", "run-r"}, {"model", "kinematic_longitudinal"},
-                                         {"format", "json"}});
-  EXPECT_EQ(json.status, dds::ReplyStatus::kBadRequest);
-  EXPECT_NE(json.error.find("neither text nor html"), std::string::npos) << json.error;
+  const auto yaml = request("residual", {{"vehicle", "res-car"}, {"run", "run-r"}, {"model", "kinematic_longitudinal"},
+                                         {"format", "yaml"}});
+  EXPECT_EQ(yaml.status, dds::ReplyStatus::kBadRequest);
+  EXPECT_NE(yaml.error.find("neither text nor json nor html"), std::string::npos) << yaml.error;
+}
+
+// The diagnosis and the loop for tools: --json after the subcommand, one JSON object each.
+TEST(E2eResidualCli, DiagnosesAndTracesInTextAndJson) {
+  TempDir dir;
+  InProcessServer server(server_options(dir.file("store.db")));
+  const auto run = test_run("trace-car", "run-t", 44u);
+  TestCar car("trace-car");
+  ASSERT_TRUE(car.stream(run.announcement, cut_run(run, 9u)));
+  const std::vector<std::string> where{"--vehicle", "trace-car", "--run", "run-t", "--model", "kinematic_longitudinal"};
+
+  std::vector<std::string> args{"residual"};
+  args.insert(args.end(), where.begin(), where.end());
+  args.push_back("--json");
+  const auto diagnosis = dynid(args);
+  ASSERT_EQ(diagnosis.exit_code, 0) << diagnosis.err;
+  const auto d = nlohmann::json::parse(diagnosis.out);
+  EXPECT_EQ(d.at("model"), "kinematic_longitudinal");
+  const std::string verdict = d.at("verdict");
+  EXPECT_TRUE(verdict == "adequate" || verdict == "explained" || verdict == "structure left") << verdict;
+  EXPECT_FALSE(d.at("floor").at("groups").empty());
+  EXPECT_FALSE(d.at("candidates").empty());
+
+  args = {"trace"};
+  args.insert(args.end(), where.begin(), where.end());
+  args.insert(args.end(), {"--reference", "sensor_scale=1.0"});
+  const auto text = dynid(args);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  for (const std::string word : {"trace of kinematic_longitudinal", "== round 1", "stopped: "})
+    EXPECT_NE(text.out.find(word), std::string::npos) << "missing '" << word << "' in\n" << text.out;
+  args.push_back("--json");
+  const auto json = dynid(args);
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  const auto t = nlohmann::json::parse(json.out);
+  EXPECT_FALSE(t.at("rounds").empty());
+  EXPECT_FALSE(t.at("stopped").get<std::string>().empty());
+  EXPECT_EQ(t.at("rounds").size(), t.at("added").size() + 1);
+
+  args = {"trace"};
+  args.insert(args.end(), where.begin(), where.end());
+  args.insert(args.end(), {"--reference", "mass"});
+  const auto bad = dynid(args);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("expected name=value"), std::string::npos) << bad.err;
+  args = {"trace"};
+  args.insert(args.end(), where.begin(), where.end());
+  args.insert(args.end(), {"--rounds", "99"});
+  const auto rounds = dynid(args);
+  EXPECT_EQ(rounds.exit_code, 2);
+  EXPECT_NE(rounds.err.find("0 to 10"), std::string::npos) << rounds.err;
 }
 
 }  // namespace

@@ -3,12 +3,14 @@
 // through a model's rows, the stated rate of false alarms, and the three verdicts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
 
 #include "dynid/model/registry.hpp"
 #include "dynid/residual/diagnosis.hpp"
+#include "dynid/residual/trace.hpp"
 
 namespace dynid::residual {
 namespace {
@@ -149,6 +151,42 @@ TEST(Diagnosis, StructureNoCandidateExplainsIsSaidWithItsSignature) {
                                  [](const CorrelationFinding& f) { return f.channel == "time"; });
   ASSERT_NE(time, d.signature.correlations.end()) << "the drift's signature is its correlation with time";
   EXPECT_GT(time->correlation, 0.0);
+}
+
+// The loop: the grade is explained by the road profile, added, and the model is then adequate;
+// the before/after table carries the references' errors.
+TEST(Trace, AddsTheEffectThatExplainsTheResidualThenStopsAtTheFloor) {
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  TraceOptions options;
+  options.reference = {{"sensor_scale", 1.02}};
+  const Trace t = trace(*model, {}, kinematic_run(7, 0.04), options);
+  ASSERT_EQ(t.rounds.size(), 2U) << t.stopped;
+  EXPECT_EQ(t.added(), std::vector<std::string>{"road_grade_profile"});
+  EXPECT_EQ(t.rounds[1].effects, std::vector<std::string>{"road_grade_profile"});
+  EXPECT_EQ(t.rounds[1].diagnosis.verdict, Verdict::kAdequate) << t.rounds[1].diagnosis.statement();
+  EXPECT_EQ(t.stopped.rfind("adequate after 1 added effect", 0), 0U) << t.stopped;
+  ASSERT_TRUE(t.rounds[0].added);
+  const EffectComparison& c = *t.rounds[0].added;
+  EXPECT_GT(c.held_out_drop(), 0.3);
+  const auto scale = std::find_if(c.parameters.begin(), c.parameters.end(),
+                                  [](const ParameterChange& p) { return p.name == "sensor_scale"; });
+  ASSERT_NE(scale, c.parameters.end());
+  ASSERT_TRUE(scale->truth);
+  EXPECT_LT(std::abs(scale->error_after_percent()), std::abs(scale->error_before_percent()));
+
+  options.max_rounds = 0;
+  const Trace limited = trace(*model, {}, kinematic_run(7, 0.04), options);
+  ASSERT_EQ(limited.rounds.size(), 1U);
+  EXPECT_TRUE(limited.added().empty());
+  EXPECT_NE(limited.stopped.find("limit of 0 added effects; road_grade_profile would be next"), std::string::npos)
+      << limited.stopped;
+}
+
+TEST(Trace, AModelThatLacksNothingAddsNothing) {
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  const Trace t = trace(*model, {}, kinematic_run(2, 0.0));
+  EXPECT_TRUE(t.added().empty());
+  EXPECT_EQ(t.stopped, "adequate after 0 added effects");
 }
 
 }  // namespace

@@ -139,6 +139,7 @@ int main(int argc, char** argv) {
   if (const char* env = std::getenv("DYNID_CYCLONE_CONFIG")) c.config = env;
   CLI::App app{"dynid: vehicles, runs and parameter estimates from dynid-server"};
   app.require_subcommand(1);
+  app.fallthrough();  // --json and the connection options may also follow the subcommand
   app.add_option("--cyclone-config", c.config,
                  "Cyclone DDS configuration: file, file:// URI or XML (or $DYNID_CYCLONE_CONFIG)");
   app.add_option("--domain", c.domain, "DDS domain id");
@@ -168,6 +169,7 @@ int main(int argc, char** argv) {
   reprocess_cmd->add_option("--model", model)->required();
   reprocess_cmd->add_option("--effects", effects, "comma-separated candidate effects");
   std::string candidates, effect, html;
+  std::vector<std::string> references;
   auto* residual_cmd = app.add_subcommand("residual", "which effect does a run's model lack? (docs/RESIDUAL.md)");
   residual_cmd->add_option("--vehicle", vehicle)->required();
   residual_cmd->add_option("--run", run)->required();
@@ -182,6 +184,17 @@ int main(int argc, char** argv) {
   add_effect_cmd->add_option("--effect", effect, "the effect to add, e.g. road_grade")->required();
   add_effect_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's)");
   add_effect_cmd->add_option("--html", html, "write the HTML report with plots to this file");
+  add_effect_cmd->add_option("--reference", references, "a known value, name=value (repeat), e.g. mass=1457.5");
+  std::string rounds;
+  auto* trace_cmd = app.add_subcommand(
+      "trace", "the residual loop: diagnose, add the effect that explains the residual, again (docs/RESIDUAL.md)");
+  trace_cmd->add_option("--vehicle", vehicle)->required();
+  trace_cmd->add_option("--run", run)->required();
+  trace_cmd->add_option("--model", model)->required();
+  trace_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's; none: no effect)");
+  trace_cmd->add_option("--reference", references, "a known value, name=value (repeat), e.g. mass=1457.5");
+  trace_cmd->add_option("--rounds", rounds, "effects the loop may add (0 to 10, default 4)");
+  trace_cmd->add_option("--html", html, "write the HTML report with plots to this file");
   auto* base_cmd = app.add_subcommand("base", "base-parameter report of a run's model");
   base_cmd->add_option("--vehicle", vehicle)->required();
   base_cmd->add_option("--run", run)->required();
@@ -218,10 +231,12 @@ int main(int argc, char** argv) {
     }
     if (*reprocess_cmd)
       return request(c, "reprocess", args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects}}));
-    if (*residual_cmd || *add_effect_cmd) {
+    if (*residual_cmd || *add_effect_cmd || *trace_cmd) {
       auto a = args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects},
-                     {"candidates", candidates}, {"effect", effect}, {"format", html.empty() ? "" : "html"}});
-      return report_request(c, *residual_cmd ? "residual" : "add-effect", a, html);
+                     {"candidates", candidates}, {"effect", effect}, {"rounds", rounds},
+                     {"format", html.empty() ? "" : "html"}});
+      for (const auto& r : references) a.push_back({"reference", r});
+      return report_request(c, *residual_cmd ? "residual" : (*add_effect_cmd ? "add-effect" : "trace"), a, html);
     }
     if (*base_cmd) return request(c, "base", args({{"vehicle", vehicle}, {"run", run}, {"model", model}}));
     if (*close_cmd) return request(c, "close", args({{"vehicle", vehicle}, {"run", run}}));

@@ -212,7 +212,7 @@ void accept_best(Diagnosis& d) {
     for (const GroupFloor& g : d.floor.groups)
       if (g.rows > 0 && g.ratio * kept < lowest_ratio(g)) under = &g;
     if (under == nullptr) {
-      d.accepted = &c;
+      d.accepted = c;
       return;
     }
     d.refused.push_back({c.effect, "takes the " + under->group + " residual below the noise floor" +
@@ -290,7 +290,7 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
     return d;
   }
   accept_best(d);
-  d.verdict = d.accepted != nullptr ? Verdict::kExplained : Verdict::kStructureLeft;
+  d.verdict = d.accepted ? Verdict::kExplained : Verdict::kStructureLeft;
   const SignatureInputs in{model, segments, d.screen.fit, d.floor, rate, odmf,
                            options.screen.fit.cross_validation.block_seconds};
   d.signature = signature_of(in, options);

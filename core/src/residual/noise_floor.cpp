@@ -264,6 +264,7 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
   // read leaves the residual exactly unchanged at the first draw and gets no more.
   std::vector<std::vector<LagSums>> shares;  // [channel][group]
   std::vector<double> share_relative_variance;
+  std::vector<std::string> contributing;
   std::mt19937_64 rng(options.seed);
   for (const ChannelNoise& c : noise) {
     const Eigen::Index column = column_of(run.announcement, c.channel);
@@ -278,10 +279,12 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
     }
     if (std::all_of(sums.begin(), sums.end(), [](const LagSums& l) { return l.square == 0.0; })) continue;
     shares.push_back(std::move(sums));
+    contributing.push_back(c.channel);
     share_relative_variance.push_back(c.level_relative_variance);
   }
   NoiseFloor out;
   out.channels = noise;
+  out.contributing = contributing;
   out.draws = options.draws;
   const auto tested = static_cast<double>(std::count_if(r0.begin(), r0.end(), [](const auto& r) { return !r.empty(); }));
   for (std::size_t g = 0; g < r0.size(); ++g) {

@@ -1,9 +1,11 @@
 #include "dynid/report/residual_report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "dynid/residual/road_profile.hpp"
 
@@ -79,6 +81,156 @@ std::string format_comparison_text(const residual::EffectComparison& c) {
   }
   return out + fmt::format("weighted residual RMS: {:.1f} % lower in sample, {:.1f} % lower held out\n",
                            100.0 * c.in_sample_drop(), 100.0 * c.held_out_drop());
+}
+
+std::string format_diagnosis_text(const residual::Diagnosis& d, std::size_t top) {
+  std::string out;
+  for (const residual::GroupFloor& g : d.floor.groups)
+    if (g.rows > 0)
+      out += fmt::format("group {}: residual RMS {} against a noise floor of {} (ratio of squares {:.3g}; at the "
+                         "floor up to {:.3g}, {:.0f} effective rows)\n",
+                         g.group, number(g.residual_rms), number(g.floor_rms), g.ratio, g.upper_ratio,
+                         g.effective_rows);
+  std::string noise;
+  for (const residual::ChannelNoise& c : d.floor.channels)
+    if (std::find(d.floor.contributing.begin(), d.floor.contributing.end(), c.channel) != d.floor.contributing.end())
+      noise += fmt::format("{}{} {:.4g} ({})", noise.empty() ? "" : ", ", c.channel, c.sigma, c.source);
+  if (!noise.empty()) out += "noise of the channels the rows read: " + noise + "\n";
+  out += format_screen_text(d.screen, top);
+  for (const residual::RefusedCandidate& r : d.refused) out += "refused: " + r.effect + ": " + r.reason + "\n";
+  for (const residual::CorrelationFinding& f : d.signature.correlations)
+    out += fmt::format("residual of {} correlates with {} at lag {:+.0f} ms: r = {:.2f} (bound {:.2f})\n", f.group,
+                       f.channel, 1000.0 * f.lag_s, f.correlation, f.bound);
+  return out + "diagnosis: " + d.statement() + "\n";
+}
+
+std::string format_trace_text(const residual::Trace& t) {
+  std::string out = fmt::format("trace of {} (declared effects: {})\n", t.model,
+                                t.declared.empty() ? "none" : fmt::format("{}", fmt::join(t.declared, ", ")));
+  for (std::size_t i = 0; i < t.rounds.size(); ++i) {
+    const residual::TraceRound& r = t.rounds[i];
+    out += fmt::format("\n== round {} (effects: {}) ==\n{}\n", i + 1,
+                       r.effects.empty() ? "none" : fmt::format("{}", fmt::join(r.effects, ", ")),
+                       r.diagnosis.statement());
+    if (r.added) out += format_comparison_text(*r.added);
+  }
+  const std::vector<std::string> added = t.added();
+  return out + fmt::format("\nadded: {}\nstopped: {}\n", added.empty() ? "nothing" : fmt::format("{}", fmt::join(added, ", ")),
+                           t.stopped);
+}
+
+namespace {
+
+using nlohmann::json;
+
+json finite(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json candidate_json(const residual::CandidateScore& c) {
+  return {{"effect", c.effect},
+          {"kind", residual::kind_name(c.kind)},
+          {"description", c.description},
+          {"evaluated", c.evaluated},
+          {"note", c.note},
+          {"columns", c.columns},
+          {"rows", c.rows},
+          {"rows_outside", c.rows_outside},
+          {"in_sample_drop", finite(c.in_sample_drop)},
+          {"held_out_drop", finite(c.held_out_drop)},
+          {"wald_statistic", finite(c.wald_statistic)},
+          {"p_value", finite(c.p_value)},
+          {"testable", c.testable},
+          {"significant", c.significant}};
+}
+
+json diagnosis_object(const residual::Diagnosis& d) {
+  json groups = json::array();
+  for (const residual::GroupFloor& g : d.floor.groups)
+    groups.push_back({{"group", g.group},
+                      {"rows", g.rows},
+                      {"residual_rms", finite(g.residual_rms)},
+                      {"floor_rms", finite(g.floor_rms)},
+                      {"ratio", finite(g.ratio)},
+                      {"upper_ratio", finite(g.upper_ratio)},
+                      {"effective_rows", finite(g.effective_rows)},
+                      {"at_floor", g.at_floor}});
+  json noise = json::array();
+  for (const residual::ChannelNoise& c : d.floor.channels)
+    noise.push_back({{"channel", c.channel}, {"sigma", finite(c.sigma)}, {"source", c.source}});
+  json candidates = json::array();
+  for (const residual::CandidateScore& c : d.screen.candidates) candidates.push_back(candidate_json(c));
+  json refused = json::array();
+  for (const residual::RefusedCandidate& r : d.refused) refused.push_back({{"effect", r.effect}, {"reason", r.reason}});
+  json correlations = json::array();
+  for (const residual::CorrelationFinding& f : d.signature.correlations)
+    correlations.push_back({{"group", f.group},
+                            {"channel", f.channel},
+                            {"lag_s", f.lag_s},
+                            {"correlation", finite(f.correlation)},
+                            {"bound", finite(f.bound)}});
+  return {{"model", d.screen.fit.model},
+          {"effects", d.screen.fit.effects},
+          {"verdict", residual::verdict_name(d.verdict)},
+          {"statement", d.statement()},
+          {"accepted", d.accepted ? json(d.accepted->effect) : json(nullptr)},
+          {"floor", {{"groups", groups}, {"channels", noise}, {"contributing", d.floor.contributing}}},
+          {"candidate_level", finite(d.screen.level)},
+          {"candidates", candidates},
+          {"refused", refused},
+          {"signature",
+           {{"correlations", correlations},
+            {"span_group", d.signature.span_group},
+            {"span_start_s", d.signature.span_start_s},
+            {"span_end_s", d.signature.span_end_s},
+            {"span_ratio", finite(d.signature.span_ratio)},
+            {"peak_frequency_hz", finite(d.signature.peak_frequency_hz)}}}};
+}
+
+json fit_groups(const residual::ModelFit& f) {
+  json out = json::array();
+  for (const residual::GroupFit& g : f.groups)
+    out.push_back({{"group", g.group},
+                   {"rows", g.rows},
+                   {"rms_in_sample", finite(g.rms_in_sample)},
+                   {"rms_held_out", finite(g.rms_held_out)},
+                   {"relative_norm_in_sample", finite(g.relative_norm_in_sample)},
+                   {"relative_norm_held_out", finite(g.relative_norm_held_out)}});
+  return out;
+}
+
+json comparison_object(const residual::EffectComparison& c) {
+  json parameters = json::array();
+  for (const residual::ParameterChange& p : c.parameters)
+    parameters.push_back({{"name", p.name},
+                          {"unit", p.unit},
+                          {"before", finite(p.before)},
+                          {"std_before", finite(p.std_before)},
+                          {"after", finite(p.after)},
+                          {"std_after", finite(p.std_after)},
+                          {"reference", p.truth ? finite(*p.truth) : json(nullptr)},
+                          {"error_before_percent", finite(p.error_before_percent())},
+                          {"error_after_percent", finite(p.error_after_percent())}});
+  return {{"effect", c.effect},
+          {"parameters", parameters},
+          {"groups_before", fit_groups(c.before)},
+          {"groups_after", fit_groups(c.after)},
+          {"in_sample_drop", finite(c.in_sample_drop())},
+          {"held_out_drop", finite(c.held_out_drop())}};
+}
+
+}  // namespace
+
+std::string diagnosis_json(const residual::Diagnosis& d) { return diagnosis_object(d).dump(); }
+std::string comparison_json(const residual::EffectComparison& c) { return comparison_object(c).dump(); }
+
+std::string trace_json(const residual::Trace& t) {
+  json rounds = json::array();
+  for (const residual::TraceRound& r : t.rounds)
+    rounds.push_back({{"effects", r.effects},
+                      {"diagnosis", diagnosis_object(r.diagnosis)},
+                      {"added", r.added ? comparison_object(*r.added) : json(nullptr)}});
+  return json{{"model", t.model}, {"declared", t.declared}, {"rounds", rounds}, {"added", t.added()},
+              {"stopped", t.stopped}}
+      .dump();
 }
 
 }  // namespace dynid::report

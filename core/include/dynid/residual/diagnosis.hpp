@@ -27,6 +27,7 @@
 // holds for two autocorrelated series; a correlation is significant beyond the normal quantile
 // 1 - error_rate / (2 M), M the number of correlations computed (Bonferroni).
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -73,9 +74,8 @@ struct RefusedCandidate {
 struct Diagnosis {
   NoiseFloor floor;
   ScreenResult screen;
-  /// The significant candidate that explains the residual (nullptr unless kExplained); points
-  /// into screen.candidates.
-  const CandidateScore* accepted = nullptr;
+  /// The significant candidate that explains the residual (kExplained only).
+  std::optional<CandidateScore> accepted;
   std::vector<RefusedCandidate> refused;  ///< significant candidates refused, with the reason
   Signature signature;
   Verdict verdict = Verdict::kAdequate;

@@ -86,6 +86,7 @@ struct NoiseFloorOptions {
 
 struct NoiseFloor {
   std::vector<ChannelNoise> channels;
+  std::vector<std::string> contributing;  ///< the channels whose noise reaches the model's rows
   std::vector<GroupFloor> groups;
   int draws = 0;
   /// Every group with rows is at its floor.

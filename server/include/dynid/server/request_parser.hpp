@@ -47,4 +47,11 @@ ParsedRequest parse_request(const dds::Request& request);
 /// "a,b,,c" -> {"a", "b", "c"}.
 std::vector<std::string> split_list(const std::string& text);
 
+/// "name=value" arguments (the trace's references) as a map; InputError naming the argument when
+/// one has no '=', an empty name, a value that is not a finite number, or a name given twice.
+std::map<std::string, double> parse_references(const std::vector<std::string>& arguments);
+
+/// The trace's `rounds`: absent = 4; InputError unless an integer in 0..10.
+int parse_rounds(const std::optional<std::string>& text);
+
 }  // namespace dynid::server

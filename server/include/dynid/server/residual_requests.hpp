@@ -1,18 +1,23 @@
 #pragma once
 // The residual loop's requests on a stored run (DESIGN.md "Residual loop"; core/residual):
 //
-//   residual    vehicle*, run*, model*, effects, candidates, format   rank the candidate effects
+//   residual    vehicle*, run*, model*, effects, candidates, format   diagnose: noise floor,
+//                                                                     ranked candidates, verdict
 //   add-effect  vehicle*, run*, model*, effect*, effects, format      before/after report
+//   trace       vehicle*, run*, model*, effects, reference, rounds,    the loop: diagnose, add,
+//               format                                                diagnose again (trace.hpp)
 //
 // `effects` (comma list) are the model's declared effects; absent, those the run's announcement
-// gives the model. `candidates` (comma list) restricts the screen. format: text (default),
-// html (the self-contained page of report/residual_html.hpp) or json is refused (the report is
-// for people; the estimate tables are the machine-readable output).
+// gives the model; "none", no effect. `candidates` (comma list) restricts the screen. `reference` (repeatable,
+// name=value, e.g. mass=1457.5): known values, whose errors the trace reports. `rounds`: effects
+// the trace may add (0..10, default 4). format: text (default), json (for tools), or html (the
+// self-contained page of report/residual_html.hpp; a trace's page shows its last added effect).
 //
 // The run is replayed from the store (every chunk up to the highest contiguous one), assembled
 // and preprocessed offline (ingest/recorded_run.hpp). Pure: no DDS, no store; RunService feeds
 // it the run's announcement and chunks. Errors: InputError (a model the announcement does not
 // run, an unknown effect, a channel missing) reach the engineer as BAD_REQUEST.
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,12 +32,15 @@ struct ResidualRequest {
   std::optional<std::vector<std::string>> effects;  ///< declared; absent: the announcement's
   std::vector<std::string> candidates;              ///< empty: every candidate
   std::string effect;                               ///< add-effect only
-  std::string format = "text";                      ///< text | html
+  std::string format = "text";                      ///< text | json | html
+  std::string kind = "residual";                    ///< residual | add-effect | trace
+  std::map<std::string, double> reference;          ///< trace only
+  int rounds = 4;                                   ///< trace only
 };
 
 struct ResidualReply {
   std::string payload;
-  std::string payload_format;  ///< "text/plain" or "text/html"
+  std::string payload_format;  ///< "text/plain", "application/json" or "text/html"
 };
 
 ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,

@@ -1,13 +1,15 @@
 #pragma once
-// The residual loop as engineers read it (core/residual): the candidate ranking with its
-// verdict, and the before/after table of an added effect, as fixed-width text (dynid residual,
-// dynid add-effect, the tests' printouts) and as one self-contained HTML page with plots
-// (residual_html.hpp).
+// The residual loop as engineers read it (core/residual): the diagnosis (noise floor, ranking,
+// verdict), the before/after table of an added effect, and the loop's rounds (dynid trace), as
+// fixed-width text (dynid residual, add-effect, trace; the tests' printouts), as JSON for tools
+// (--json), and as one self-contained HTML page with plots (residual_html.hpp).
 #include <cstddef>
 #include <string>
 
+#include "dynid/residual/diagnosis.hpp"
 #include "dynid/residual/effect_comparison.hpp"
 #include "dynid/residual/effect_screen.hpp"
+#include "dynid/residual/trace.hpp"
 
 namespace dynid::report {
 
@@ -19,5 +21,19 @@ std::string format_screen_text(const residual::ScreenResult& screen, std::size_t
 /// known), per group the residual RMS and relative norm in sample and held out, the weighted
 /// drops. A road profile's knots are summarised in one line, not listed.
 std::string format_comparison_text(const residual::EffectComparison& comparison);
+
+/// The diagnosis: per group the residual against its noise floor, the channels whose noise makes
+/// the floor, the ranking (format_screen_text), refused candidates, the signature's
+/// correlations, and the verdict's statement.
+std::string format_diagnosis_text(const residual::Diagnosis& diagnosis, std::size_t top = 10);
+
+/// Every round of the loop (its diagnosis's statement, the effect it added with the before/after
+/// table) and why it stopped.
+std::string format_trace_text(const residual::Trace& trace);
+
+/// The same as JSON objects, for tools (nlohmann::json; NaN and infinities as null).
+std::string diagnosis_json(const residual::Diagnosis& diagnosis);
+std::string comparison_json(const residual::EffectComparison& comparison);
+std::string trace_json(const residual::Trace& trace);
 
 }  // namespace dynid::report

@@ -1,0 +1,76 @@
+#include "dynid/residual/trace.hpp"
+
+#include <cmath>
+
+#include "dynid/error.hpp"
+
+namespace dynid::residual {
+namespace {
+
+// Why adding the accepted candidate is refused, or empty when it is not.
+std::string refusal(const EffectComparison& c) {
+  if (!(c.held_out_drop() > 0.0))
+    return c.effect + " refused: with it the held-out residual is not lower (" +
+           std::to_string(100.0 * -c.held_out_drop()) + " %)";
+  // Out of bounds by more than two standard deviations: a parameter that may truly be near a
+  // bound (a rolling resistance near 0) falls on the wrong side of it by noise half the time.
+  for (std::size_t i = 0; i < c.parameters.size() && i < c.after.parameters.size(); ++i) {
+    const model::ParameterInfo& info = c.after.parameters[i];
+    const ParameterChange& p = c.parameters[i];
+    const double margin = 2.0 * (std::isfinite(p.std_after) ? p.std_after : 0.0);
+    if (!info.within_bounds(p.after - margin) && !info.within_bounds(p.after + margin))
+      return c.effect + " refused: it takes " + info.name + " to " + std::to_string(p.after) + " +- " +
+             std::to_string(p.std_after) + " " + info.unit + ", outside its physical bounds (" + info.bounds_text() +
+             ") by more than two standard deviations";
+  }
+  return {};
+}
+
+}  // namespace
+
+std::vector<std::string> Trace::added() const {
+  std::vector<std::string> out;
+  for (const TraceRound& r : rounds)
+    if (r.added) out.push_back(r.added->effect);
+  return out;
+}
+
+Trace trace(const model::Model& model, const std::vector<std::string>& declared,
+            const ingest::RecordedRun& run, const TraceOptions& options) {
+  if (options.max_rounds < 0) throw InputError("trace: max_rounds " + std::to_string(options.max_rounds) + " < 0");
+  const std::vector<ingest::PreprocessedSegment> segments = ingest::preprocess_offline(run);
+  const double rate = run.announcement.sample_rate_hz;
+  const int odmf = run.announcement.preprocessing.odmf;
+  Trace t;
+  t.model = model.name();
+  t.declared = declared;
+  std::vector<std::string> effects = declared;
+  for (int round = 0;; ++round) {
+    TraceRound r{effects, diagnose(model, effects, run, options.diagnosis), std::nullopt};
+    const Verdict verdict = r.diagnosis.verdict;
+    if (verdict != Verdict::kExplained) {
+      t.stopped = std::string(verdict_name(verdict)) + " after " + std::to_string(round) + " added effect" +
+                  (round == 1 ? "" : "s");
+      t.rounds.push_back(std::move(r));
+      return t;
+    }
+    if (round == options.max_rounds) {
+      t.stopped = "stopped at the limit of " + std::to_string(options.max_rounds) + " added effects; " +
+                  r.diagnosis.accepted->effect + " would be next";
+      t.rounds.push_back(std::move(r));
+      return t;
+    }
+    EffectComparison c = compare_effect(model, effects, r.diagnosis.accepted->effect, segments, rate, odmf,
+                                        options.diagnosis.screen.fit, options.reference);
+    if (const std::string why = refusal(c); !why.empty()) {
+      t.stopped = why;
+      t.rounds.push_back(std::move(r));
+      return t;
+    }
+    effects.push_back(c.effect);
+    r.added = std::move(c);
+    t.rounds.push_back(std::move(r));
+  }
+}
+
+}  // namespace dynid::residual
