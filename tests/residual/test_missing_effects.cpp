@@ -68,13 +68,12 @@ void expect_found_and_fixed(const Case& c, std::uint64_t seed) {
               c.model.c_str());
   test::print_ranking(screen, 8);
   std::printf("%s\n", diagnosis.statement().c_str());
-  EXPECT_EQ(diagnosis.verdict, Verdict::kExplained) << c.title << ": " << diagnosis.statement();
-  const CandidateScore* best = screen.best();
-  ASSERT_NE(best, nullptr) << c.title << ": nothing significant";
-  EXPECT_NE(std::find(c.true_effects.begin(), c.true_effects.end(), best->effect), c.true_effects.end())
-      << c.title << ": ranked first " << best->effect;
+  ASSERT_EQ(diagnosis.verdict, Verdict::kExplained) << c.title << ": " << diagnosis.statement();
+  const CandidateScore& best = *diagnosis.accepted;
+  EXPECT_NE(std::find(c.true_effects.begin(), c.true_effects.end(), best.effect), c.true_effects.end())
+      << c.title << ": explained by " << best.effect;
 
-  const EffectComparison cmp = compare_effect(*model, c.declared, best->effect, processed.segments, rate, odmf,
+  const EffectComparison cmp = compare_effect(*model, c.declared, best.effect, processed.segments, rate, odmf,
                                               {}, truth_of(run, c));
   test::print_comparison(c.title, cmp);
   EXPECT_LT(cmp.after.weighted_rms_held_out, cmp.before.weighted_rms_held_out) << c.title;
