@@ -25,7 +25,7 @@ TEST(E2eResidualCli, RanksEffectsAndWritesTheBeforeAfterReport) {
   args.insert(args.end(), where.begin(), where.end());
   const auto screen = dynid(args);
   ASSERT_EQ(screen.exit_code, 0) << screen.err;
-  for (const std::string word : {"model kinematic_longitudinal", "candidate", "held-out%", "dict:sq:vx", "verdict:"})
+  for (const std::string word : {"model kinematic_longitudinal", "noise floor", "candidate", "held-out%", "HAC Wald", "diagnosis: "})
     EXPECT_NE(screen.out.find(word), std::string::npos) << "missing '" << word << "' in\n" << screen.out;
 
   args = {"add-effect"};

@@ -10,6 +10,7 @@
 
 #include "dynid/model/registry.hpp"
 #include "dynid/residual/diagnosis.hpp"
+#include "dynid/residual/effect_comparison.hpp"
 #include "dynid/residual/trace.hpp"
 
 namespace dynid::residual {
@@ -143,6 +144,7 @@ TEST(Diagnosis, StructureNoCandidateExplainsIsSaidWithItsSignature) {
   DiagnosisOptions options;
   options.screen.dictionary = false;
   options.screen.road_profile = false;
+  options.screen.varying_parameters = false;
   const Diagnosis d = diagnose(*model, {}, run, options);
   std::printf("%s\n", d.statement().c_str());
   ASSERT_EQ(d.verdict, Verdict::kStructureLeft) << d.statement();
@@ -151,6 +153,48 @@ TEST(Diagnosis, StructureNoCandidateExplainsIsSaidWithItsSignature) {
                                  [](const CorrelationFinding& f) { return f.channel == "time"; });
   ASSERT_NE(time, d.signature.correlations.end()) << "the drift's signature is its correlation with time";
   EXPECT_GT(time->correlation, 0.0);
+}
+
+// A sensor offset that drifts over the run is a parameter that is not constant: the drift
+// candidate explains it, with the rate in the parameter's unit per second. (At this run's nearly
+// constant speed a grade profile over distance explains it as well and is preferred: the screen
+// is asked without the profile here.)
+TEST(Diagnosis, ADriftingOffsetIsExplainedByItsDrift) {
+  auto run = kinematic_run(9, 0.0);
+  for (Eigen::Index k = 0; k < run.samples.rows(); ++k) run.samples(k, 1) += 0.4 * static_cast<double>(k) / 6000.0;
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  DiagnosisOptions options;
+  options.screen.road_profile = false;
+  const Diagnosis d = diagnose(*model, {}, run, options);
+  ASSERT_EQ(d.verdict, Verdict::kExplained) << d.statement();
+  EXPECT_EQ(d.accepted->effect, "drift:sensor_offset");
+  const EffectComparison c = compare_effect(*model, {}, "drift:sensor_offset", ingest::preprocess_offline(run),
+                                            kRate, run.announcement.preprocessing.odmf);
+  ASSERT_EQ(c.parameters.back().name, "sensor_offset_drift");
+  EXPECT_EQ(c.parameters.back().unit, "m/s^2/s");
+  EXPECT_NEAR(c.parameters.back().after, 0.4 / 60.0, 4.0 * c.parameters.back().std_after);
+}
+
+// A step of the sensor's scale at 30 s (a load change at a stop, a sensor re-mounted): located
+// at the block boundary where it happens, its size recovered.
+TEST(Diagnosis, AStepOfAParameterIsLocatedAndSized) {
+  auto run = kinematic_run(11, 0.0);
+  auto clean = kinematic_run(11, 0.0);
+  for (Eigen::Index k = 3000; k < run.samples.rows(); ++k) {
+    const double t = static_cast<double>(k) / kRate;
+    const double dv = 4.0 * 0.21 * std::cos(0.21 * t) + 1.5 * 0.9 * std::cos(0.9 * t + 0.3);
+    run.samples(k, 1) += 0.25 * dv;  // the scale goes from 1.02 to 1.27
+  }
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  const Diagnosis d = diagnose(*model, {}, run);
+  ASSERT_EQ(d.verdict, Verdict::kExplained) << d.statement();
+  EXPECT_EQ(d.accepted->effect, "step:sensor_scale@30s") << d.statement();
+  const EffectComparison c = compare_effect(*model, {}, "step:sensor_scale@30s", ingest::preprocess_offline(run),
+                                            kRate, run.announcement.preprocessing.odmf);
+  EXPECT_EQ(c.parameters.back().name, "sensor_scale_step@30s");
+  EXPECT_NEAR(c.parameters.back().after, 0.25, 4.0 * c.parameters.back().std_after);
+  EXPECT_NEAR(c.parameters[0].after, 1.02, 4.0 * c.parameters[0].std_after);  // the value before the step
+  EXPECT_EQ(diagnose(*model, {}, clean).verdict, Verdict::kAdequate);
 }
 
 // The loop: the grade is explained by the road profile, added, and the model is then adequate;

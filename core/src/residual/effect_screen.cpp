@@ -3,18 +3,21 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <utility>
 
 #include "dynid/error.hpp"
 #include "dynid/model/effects.hpp"
 #include "dynid/residual/road_profile.hpp"
+#include "dynid/residual/varying_parameter.hpp"
 #include "folded_rows.hpp"
 #include "hac_wald.hpp"
 
 namespace dynid::residual {
 namespace {
 
-// Drops closer than this are ties (the same column under two names).
-constexpr double kTie = 1e-9;
+// Relative drops closer than this are ties (the same column under two names).
+constexpr double kTie = 1e-6;
 
 struct Candidate {
   std::string effect;
@@ -58,11 +61,20 @@ std::vector<Candidate> dictionary_candidates(const model::Model& m,
 }
 
 std::vector<Candidate> candidates_of(const model::Model& m, const std::vector<std::string>& declared,
-                                     const std::vector<ingest::PreprocessedSegment>& run,
+                                     const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
                                      const ScreenOptions& options) {
   std::vector<Candidate> all;
   for (const model::Effect& e : m.candidate_effects())
     all.push_back({e.name, e.description, CandidateKind::kPhysics});
+  if (options.varying_parameters) {
+    const double t_first = static_cast<double>(run.front().first) / sample_rate_hz;
+    const double t_last =
+        static_cast<double>(run.back().first + run.back().channels.samples() - 1) / sample_rate_hz;
+    for (const std::string& name :
+         varying_candidates(m, t_first, t_last, options.fit.cross_validation.block_seconds))
+      all.push_back({name, varying_parameter_info(parse_varying_effect(name, m), m).description,
+                     CandidateKind::kVarying});
+  }
   if (options.road_profile && run.front().channels.has("vx"))
     all.push_back({road_profile_effect_name(m),
                    "an unmeasured road property (grade, bank) piecewise linear in the distance "
@@ -109,7 +121,9 @@ CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, const s
   for (std::size_t k = 0; k < after.fold_weighted_out.size(); ++k) {
     const double a = after.fold_weighted_out[k];
     const double b = before.fold_weighted_out[k];
-    if (std::isnan(a) || std::isnan(b)) continue;
+    const bool predicted = !std::isnan(a) && !std::isnan(b) && a > 0.0 && b > 0.0;
+    s.fold_log_ratio.push_back(predicted ? std::log(a / b) : std::numeric_limits<double>::quiet_NaN());
+    if (!predicted) continue;
     ++s.folds;
     if (a < b) ++s.folds_improved;
   }
@@ -131,12 +145,50 @@ void decide(ScreenResult& result, double family_error_rate) {
     c.significant = c.evaluated && c.testable && c.p_value < result.level && c.held_out_drop > 0.0;
 }
 
+// Significant first; significant physics before the rest; then by the held-out drop, the
+// predictive criterion (a candidate with many columns pays for them there); equal drops (the
+// same column under two names: road_grade and dict:x:road_grade) go to the earlier kind.
 bool ranks_before(const CandidateScore& a, const CandidateScore& b) {
   if (a.evaluated != b.evaluated) return a.evaluated;
   if (a.significant != b.significant) return a.significant;
-  if (a.significant && a.kind != b.kind) return static_cast<int>(a.kind) < static_cast<int>(b.kind);
-  if (std::abs(a.held_out_drop - b.held_out_drop) > kTie) return a.held_out_drop > b.held_out_drop;
+  const bool a_physics = a.kind == CandidateKind::kPhysics;
+  if (a.significant && a_physics != (b.kind == CandidateKind::kPhysics)) return a_physics;
+  if (std::abs(a.held_out_drop - b.held_out_drop) > kTie * std::max(1.0, std::abs(a.held_out_drop)))
+    return a.held_out_drop > b.held_out_drop;
   return static_cast<int>(a.kind) < static_cast<int>(b.kind);
+}
+
+// Mean and standard error of b's per-fold log ratios minus a's (folds both predicted).
+std::pair<double, double> paired_difference(const CandidateScore& a, const CandidateScore& b) {
+  std::vector<double> d;
+  for (std::size_t k = 0; k < a.fold_log_ratio.size() && k < b.fold_log_ratio.size(); ++k)
+    if (std::isfinite(a.fold_log_ratio[k]) && std::isfinite(b.fold_log_ratio[k]))
+      d.push_back(b.fold_log_ratio[k] - a.fold_log_ratio[k]);
+  if (d.size() < 2) return {0.0, std::numeric_limits<double>::infinity()};
+  double mean = 0.0;
+  for (double v : d) mean += v;
+  mean /= static_cast<double>(d.size());
+  double ss = 0.0;
+  for (double v : d) ss += (v - mean) * (v - mean);
+  return {mean, std::sqrt(ss / static_cast<double>(d.size() - 1) / static_cast<double>(d.size()))};
+}
+
+// The one-standard-error rule (see the header): the best significant candidate of the first
+// kind that is within one standard error of the best overall moves to the front.
+void prefer_simplest_within_one_error(std::vector<CandidateScore>& ranked) {
+  if (ranked.empty() || !ranked.front().significant || ranked.front().kind == CandidateKind::kPhysics) return;
+  const CandidateScore& best = ranked.front();
+  for (int kind = static_cast<int>(CandidateKind::kRoadProfile); kind < static_cast<int>(best.kind); ++kind) {
+    const auto first = std::find_if(ranked.begin(), ranked.end(), [&](const CandidateScore& c) {
+      return c.significant && static_cast<int>(c.kind) == kind;
+    });
+    if (first == ranked.end()) continue;
+    const auto [mean, error] = paired_difference(best, *first);
+    if (mean <= error) {
+      std::rotate(ranked.begin(), first, first + 1);
+      return;
+    }
+  }
 }
 
 std::string pvalue(double p) {
@@ -156,6 +208,7 @@ std::string percent(double fraction) {
 const char* kind_name(CandidateKind kind) {
   switch (kind) {
     case CandidateKind::kPhysics: return "physics";
+    case CandidateKind::kVarying: return "varying";
     case CandidateKind::kRoadProfile: return "road profile";
     case CandidateKind::kDictionary: return "dictionary";
   }
@@ -191,7 +244,7 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
   FitOptions fold_options = options.fit;
   fold_options.series = false;
   const detail::RowSelection declared_rows = detail::kept_rows(model, declared, run, odmf);
-  for (const Candidate& c : candidates_of(model, declared, run, options)) {
+  for (const Candidate& c : candidates_of(model, declared, run, sample_rate_hz, options)) {
     std::vector<std::string> with = declared;
     with.push_back(c.effect);
     try {
@@ -209,6 +262,7 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
   }
   decide(result, options.family_error_rate);
   std::stable_sort(result.candidates.begin(), result.candidates.end(), ranks_before);
+  prefer_simplest_within_one_error(result.candidates);
   return result;
 }
 

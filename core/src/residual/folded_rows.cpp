@@ -7,6 +7,7 @@
 
 #include "dynid/error.hpp"
 #include "dynid/residual/road_profile.hpp"
+#include "dynid/residual/varying_parameter.hpp"
 
 namespace dynid::residual::detail {
 namespace {
@@ -67,10 +68,11 @@ std::vector<Eigen::Index> decimation_grid(const ingest::PreprocessedSegment& seg
   return kept;
 }
 
+// The effects the model itself builds (a road profile or a varying parameter changes no row).
 std::vector<std::string> without_profiles(const std::vector<std::string>& effects) {
   std::vector<std::string> out;
   for (const std::string& e : effects)
-    if (!is_road_profile_effect(e)) out.push_back(e);
+    if (!is_road_profile_effect(e) && !is_varying_effect(e)) out.push_back(e);
   return out;
 }
 
@@ -99,9 +101,12 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   options.cross_validation.validate();
   if (odmf < 1) throw InputError("residual analysis: odmf " + std::to_string(odmf) + " < 1");
   std::vector<std::string> model_effects;
+  std::vector<VaryingParameter> varying;
   std::string profile_effect;
   for (const std::string& e : effects) {
-    if (!is_road_profile_effect(e)) {
+    if (is_varying_effect(e)) {
+      varying.push_back(parse_varying_effect(e, model));
+    } else if (!is_road_profile_effect(e)) {
       model_effects.push_back(e);
     } else if (profile_effect.empty()) {
       profile_effect = e;
@@ -110,10 +115,13 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
                        ", " + e + ")");
     }
   }
+  // Columns: the model's (parameters, then its effects), the varying parameters', the profile's.
   FoldedRows out;
   out.parameters = model.parameters_with(model_effects);
   out.groups = model.groups();
   const auto model_width = static_cast<Eigen::Index>(out.parameters.size());
+  for (const VaryingParameter& v : varying) out.parameters.push_back(varying_parameter_info(v, model));
+  const auto varying_end = static_cast<Eigen::Index>(out.parameters.size());
   std::unique_ptr<RoadProfile> profile;
   if (!profile_effect.empty()) {
     profile = std::make_unique<RoadProfile>(run, 1.0 / sample_rate_hz, options.profile_knot_spacing_m,
@@ -124,14 +132,21 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   if (effects.empty()) {
     out.last_effect_first = out.last_effect_end = width;
   } else if (is_road_profile_effect(effects.back())) {
-    out.last_effect_first = model_width;
+    out.last_effect_first = varying_end;
     out.last_effect_end = width;
     out.last_effect_is_profile = true;
+  } else if (is_varying_effect(effects.back())) {
+    out.last_effect_first = varying_end - 1;
+    out.last_effect_end = varying_end;
   } else {
     const std::vector<std::string> before(model_effects.begin(), model_effects.end() - 1);
     out.last_effect_first = static_cast<Eigen::Index>(model.parameters_with(before).size());
     out.last_effect_end = model_width;
   }
+  const double t_mid = run.empty() ? 0.0
+                                   : 0.5 * static_cast<double>(run.front().first + run.back().first +
+                                                               run.back().channels.samples() - 1) /
+                                         sample_rate_hz;
   const std::size_t group_count = out.groups.size();
   out.folds.assign(static_cast<std::size_t>(options.cross_validation.folds),
                    ls::EquationGroups(width, out.groups));
@@ -158,9 +173,14 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
         std::fill(row.begin(), row.end(), 0.0);
         for (Eigen::Index j = 0; j < model_width; ++j)
           row[static_cast<std::size_t>(j)] = gr.W(static_cast<Eigen::Index>(i), j);
+        const Eigen::Index grid_at = seg.first + sample;
+        const double time_at = static_cast<double>(grid_at) / sample_rate_hz;
+        for (std::size_t v = 0; v < varying.size(); ++v)
+          row[static_cast<std::size_t>(model_width) + v] =
+              varying_column(varying[v], gr.W(static_cast<Eigen::Index>(i), varying[v].column), time_at, t_mid);
         if (profile)
           profile->hats(profile->distance(s, sample),
-                        row.data() + model_width + static_cast<Eigen::Index>(g) * profile->knots());
+                        row.data() + varying_end + static_cast<Eigen::Index>(g) * profile->knots());
         row.back() = gr.y(static_cast<Eigen::Index>(i));
         const Eigen::Index grid = seg.first + sample;
         const double t = static_cast<double>(grid) / sample_rate_hz;

@@ -321,6 +321,7 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
     f.floor_relative_std = std::sqrt(floor_variance / (total.square * total.square) +
                                      2.0 / (options.draws * f.effective_rows));
     const double sd = std::sqrt(2.0 / f.effective_rows + f.floor_relative_std * f.floor_relative_std);
+    f.log_ratio_std = sd;
     const double z = boost::math::quantile(boost::math::normal(), 1.0 - options.error_rate / tested);
     f.upper_ratio = std::exp(z * sd);
     f.at_floor = f.ratio <= f.upper_ratio;

@@ -71,6 +71,7 @@ struct GroupFloor {
   double ratio = 0.0;           ///< residual_rms^2 / floor_rms^2
   double effective_rows = 0.0;  ///< of the variance estimate
   double floor_relative_std = 0.0;  ///< of the floor's mean square (sigmas measured, draws)
+  double log_ratio_std = 0.0;   ///< std of log(ratio) for a model that lacks nothing
   double upper_ratio = 0.0;     ///< the test's critical ratio
   bool at_floor = false;
 };

@@ -1,0 +1,47 @@
+#pragma once
+// Varying parameters: candidate effects for a parameter that is not constant over the run
+// (issue 15: "a load change at a stop, a friction level that drifts over the run"). Each is one
+// extra column made of a declared parameter's own column W_j:
+//   drift:<parameter>          W_j (t - t_mid)      the parameter changes linearly with time;
+//                                                    its coefficient is the rate (unit / s), the
+//                                                    parameter itself its value at mid-run
+//   step:<parameter>@<t0>s     W_j [t >= t0]        the parameter changes at t0 (s of run time);
+//                                                    its coefficient is the change
+// The residual screen offers a drift of every parameter of the model and a step at every
+// cross-validation block boundary but the first and the last (a step needs data on both sides);
+// a step found is reported as a time. The column enters every equation group where W_j does.
+// On a run at nearly constant speed a drift or step of an offset and a road profile (a function
+// of distance) explain the same residual: the screen prefers the profile within one standard
+// error (effect_screen.hpp).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dynid/model/model.hpp"
+
+namespace dynid::residual {
+
+struct VaryingParameter {
+  enum class Kind { kDrift, kStep } kind = Kind::kDrift;
+  std::string parameter;
+  Eigen::Index column = 0;  ///< the parameter's column in the model's rows
+  double step_time_s = 0.0; ///< kStep: t0
+};
+
+bool is_varying_effect(const std::string& name);
+
+/// Parses `name` against `model`'s parameters. InputError naming the effect when the form is
+/// wrong, the parameter unknown, or t0 not a finite number.
+VaryingParameter parse_varying_effect(const std::string& name, const model::Model& model);
+
+/// The parameter the effect adds (no physical bounds: a change may have either sign).
+model::ParameterInfo varying_parameter_info(const VaryingParameter& v, const model::Model& model);
+
+/// The names the screen tries on a run spanning [t_first, t_last] s with blocks of `block_s`.
+std::vector<std::string> varying_candidates(const model::Model& model, double t_first, double t_last,
+                                            double block_s);
+
+/// The column's value on a row of W_j = `w`, at run time t, for a run whose middle is t_mid.
+double varying_column(const VaryingParameter& v, double w, double t, double t_mid);
+
+}  // namespace dynid::residual

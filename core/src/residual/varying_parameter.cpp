@@ -1,0 +1,86 @@
+#include "dynid/residual/varying_parameter.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "dynid/error.hpp"
+
+namespace dynid::residual {
+namespace {
+
+constexpr const char* kDrift = "drift:";
+constexpr const char* kStep = "step:";
+
+bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+Eigen::Index column_of(const model::Model& model, const std::string& name, const std::string& effect) {
+  const std::vector<model::ParameterInfo> parameters = model.parameters();
+  for (std::size_t j = 0; j < parameters.size(); ++j)
+    if (parameters[j].name == name) return static_cast<Eigen::Index>(j);
+  throw InputError("effect '" + effect + "': model '" + model.name() + "' has no parameter '" + name + "'");
+}
+
+std::string seconds(double t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", t);
+  return buf;
+}
+
+}  // namespace
+
+bool is_varying_effect(const std::string& name) { return starts_with(name, kDrift) || starts_with(name, kStep); }
+
+VaryingParameter parse_varying_effect(const std::string& name, const model::Model& model) {
+  VaryingParameter v;
+  if (starts_with(name, kDrift)) {
+    v.parameter = name.substr(std::string(kDrift).size());
+    v.column = column_of(model, v.parameter, name);
+    return v;
+  }
+  if (!starts_with(name, kStep)) throw InputError("effect '" + name + "' is not drift:<parameter> nor step:<parameter>@<t>s");
+  const std::string rest = name.substr(std::string(kStep).size());
+  const auto at = rest.rfind('@');
+  if (at == std::string::npos || rest.size() < at + 3 || rest.back() != 's')
+    throw InputError("effect '" + name + "': expected step:<parameter>@<seconds>s");
+  v.kind = VaryingParameter::Kind::kStep;
+  v.parameter = rest.substr(0, at);
+  v.column = column_of(model, v.parameter, name);
+  const std::string time = rest.substr(at + 1, rest.size() - at - 2);
+  std::size_t used = 0;
+  try {
+    v.step_time_s = std::stod(time, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != time.size() || !std::isfinite(v.step_time_s))
+    throw InputError("effect '" + name + "': '" + time + "' is not a time in seconds");
+  return v;
+}
+
+model::ParameterInfo varying_parameter_info(const VaryingParameter& v, const model::Model& model) {
+  const model::ParameterInfo p = model.parameters()[static_cast<std::size_t>(v.column)];
+  if (v.kind == VaryingParameter::Kind::kDrift)
+    return {p.name + "_drift", p.unit + "/s", "rate of change of " + p.name + " over the run (the parameter is its mid-run value)",
+            std::nullopt};
+  return {p.name + "_step@" + seconds(v.step_time_s) + "s", p.unit,
+          "change of " + p.name + " at " + seconds(v.step_time_s) + " s (the parameter is its value before)",
+          std::nullopt};
+}
+
+std::vector<std::string> varying_candidates(const model::Model& model, double t_first, double t_last,
+                                            double block_s) {
+  std::vector<std::string> out;
+  for (const model::ParameterInfo& p : model.parameters()) {
+    out.push_back(kDrift + p.name);
+    for (double t0 = (std::floor(t_first / block_s) + 2.0) * block_s; t0 <= t_last - block_s; t0 += block_s)
+      out.push_back(kStep + p.name + "@" + seconds(t0) + "s");
+  }
+  return out;
+}
+
+double varying_column(const VaryingParameter& v, double w, double t, double t_mid) {
+  if (v.kind == VaryingParameter::Kind::kDrift) return w * (t - t_mid);
+  return t >= v.step_time_s ? w : 0.0;
+}
+
+}  // namespace dynid::residual
