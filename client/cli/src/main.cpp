@@ -143,7 +143,8 @@ int main(int argc, char** argv) {
   app.add_option("--cyclone-config", c.config,
                  "Cyclone DDS configuration: file, file:// URI or XML (or $DYNID_CYCLONE_CONFIG)");
   app.add_option("--domain", c.domain, "DDS domain id");
-  app.add_option("--timeout", c.timeout_s, "seconds to wait for the server");
+  auto* timeout = app.add_option("--timeout", c.timeout_s,
+                                 "seconds to wait for the server (default 10; 120 for residual, add-effect, trace)");
   app.add_flag("--json", c.json, "JSON instead of text");
 
   std::string vehicle, run, model, effects;
@@ -232,6 +233,9 @@ int main(int argc, char** argv) {
     if (*reprocess_cmd)
       return request(c, "reprocess", args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects}}));
     if (*residual_cmd || *add_effect_cmd || *trace_cmd) {
+      // The server replays the run and fits it many times (the noise floor's draws, every
+      // candidate, every round): longer than a table look-up on a long run.
+      if (timeout->count() == 0) c.timeout_s = 120.0;
       auto a = args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects},
                      {"candidates", candidates}, {"effect", effect}, {"rounds", rounds},
                      {"format", html.empty() ? "" : "html"}});
