@@ -263,7 +263,8 @@ std::string Diagnosis::statement() const {
     }
     case Verdict::kExplained:
       return "explained: above the noise floor (" + floors + "); " + accepted->effect + " (" +
-             kind_name(accepted->kind) + ") explains it: held-out RMS " +
+             kind_name(accepted->kind) + (accepted->finding.empty() ? "" : ": " + accepted->finding) +
+             ") explains it: held-out RMS " +
              format("%+.1f %%", -100.0 * accepted->held_out_drop) +
              format(", HAC Wald p = %.2g < %.2g", accepted->p_value, screen.level);
     case Verdict::kStructureLeft:

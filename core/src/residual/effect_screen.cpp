@@ -9,6 +9,7 @@
 #include "dynid/error.hpp"
 #include "dynid/model/effects.hpp"
 #include "dynid/residual/road_profile.hpp"
+#include "dynid/residual/signal_delay.hpp"
 #include "dynid/residual/varying_parameter.hpp"
 #include "folded_rows.hpp"
 #include "hac_wald.hpp"
@@ -133,7 +134,100 @@ CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, const s
   s.wald_statistic = wald.statistic;
   s.p_value = wald.p_value;
   s.hac_lags = wald.bandwidth;
+  if (s.columns == 1) {
+    s.coefficient = after.all.value(rows.last_effect_first);
+    s.coefficient_std = wald.first_std;
+  }
   return s;
+}
+
+// The channels whose delay the screen tests: the model's own that the run has (d_x read as x: a
+// derivative moves with its channel), not its measured side.
+std::vector<std::string> delay_channels(const model::Model& m, const std::vector<ingest::PreprocessedSegment>& run,
+                                        const std::vector<std::string>& declared) {
+  std::vector<std::string> out;
+  for (const model::ChannelNeed& c : m.channels()) {
+    const std::string name = c.name.rfind("d_", 0) == 0 ? c.name.substr(2) : c.name;
+    if (!run.front().channels.has(name) || contains(m.measured_side(), name)) continue;
+    const bool already = std::any_of(declared.begin(), declared.end(), [&](const std::string& e) {
+      return is_delay_effect(e) && e.rfind("delay:" + name + "@", 0) == 0;
+    });
+    if (!already && !contains(out, name)) out.push_back(name);
+  }
+  return out;
+}
+
+struct DelayContext {
+  const model::Model& model;
+  const std::vector<std::string>& declared;
+  const std::vector<ingest::PreprocessedSegment>& run;
+  double rate;
+  int odmf;
+  const FitOptions& fit;
+  const detail::RowSelection& rows;
+  const std::vector<double>& weights;
+};
+
+std::vector<std::string> with_delay(const std::vector<std::string>& declared, const std::string& channel,
+                                    Eigen::Index samples, double rate) {
+  std::vector<std::string> out = declared;
+  out.push_back(delay_effect_name(channel, samples, rate));
+  return out;
+}
+
+// The score test of a delay of `channel` at `center` samples: the column -d r / d L (per sample
+// of delay) at the solution x0, from the rows built one sample later and one earlier. At zero it
+// tests "no delay"; at the delay found, its coefficient's standard deviation is the delay's
+// (Gauss-Newton).
+CandidateScore score_delay(const DelayContext& in, const std::string& channel, const Eigen::VectorXd& x0,
+                           Eigen::Index center = 0) {
+  const detail::FoldedRows base = detail::fold_rows(
+      in.model, center == 0 ? in.declared : with_delay(in.declared, channel, center, in.rate), in.run, in.rate,
+      in.odmf, in.fit, true, &in.rows);
+  // Delays of +-1 sample, by name at this rate (1 sample = 1000 / rate ms, rounded back exactly).
+  const auto residuals = [&](Eigen::Index samples) {
+    return detail::residuals_at(detail::fold_rows(in.model, with_delay(in.declared, channel, samples, in.rate), in.run,
+                                                  in.rate, in.odmf, in.fit, true, &in.rows),
+                                x0);
+  };
+  const detail::GridResiduals late = residuals(center + 1);
+  const detail::GridResiduals early = residuals(center - 1);
+  std::vector<std::vector<double>> column(base.groups.size());
+  for (std::size_t g = 0; g < base.groups.size(); ++g) {
+    const auto find = [](const std::vector<std::pair<Eigen::Index, double>>& r, Eigen::Index grid) {
+      const auto it = std::lower_bound(r.begin(), r.end(), std::make_pair(grid, -std::numeric_limits<double>::infinity()));
+      return it != r.end() && it->first == grid ? it->second : std::numeric_limits<double>::quiet_NaN();
+    };
+    for (const Eigen::Index grid : base.collected.grid_index[g])
+      column[g].push_back(0.5 * (find(early[g], grid) - find(late[g], grid)));
+  }
+  const model::ParameterInfo info{channel + "_delay", "samples", "delay of " + channel + " (first order)", std::nullopt};
+  const Candidate c{"delay:" + channel, "the " + channel + " signal late or early against the others",
+                    CandidateKind::kTiming};
+  return score(c, detail::with_extra_column(base, column, info, in.fit.cross_validation), in.weights, in.odmf);
+}
+
+// The delay with the least in-sample weighted residual per row, within +-max samples: steps of
+// 2 samples, then the neighbours of the best.
+Eigen::Index locate_delay(const DelayContext& in, const std::string& channel, Eigen::Index max) {
+  const auto cost = [&](Eigen::Index samples) {
+    const detail::FoldedRows rows = detail::fold_rows(
+        in.model, samples == 0 ? in.declared : with_delay(in.declared, channel, samples, in.rate), in.run, in.rate,
+        in.odmf, in.fit, false, &in.rows);
+    const detail::Evaluation e = detail::evaluate(rows, {}, in.weights);
+    return e.weighted_in() / static_cast<double>(std::max<std::uint64_t>(e.total_rows(), 1));
+  };
+  Eigen::Index best = 0;
+  double best_cost = cost(0);
+  const auto consider = [&](Eigen::Index samples) {
+    const double c = cost(samples);
+    if (c < best_cost) best_cost = c, best = samples;
+  };
+  for (Eigen::Index l = -max; l <= max; l += 2) consider(l);
+  const Eigen::Index coarse = best;
+  consider(coarse - 1);
+  consider(coarse + 1);
+  return best;
 }
 
 // Significance once every candidate is scored: the level is shared out among them.
@@ -209,6 +303,7 @@ const char* kind_name(CandidateKind kind) {
   switch (kind) {
     case CandidateKind::kPhysics: return "physics";
     case CandidateKind::kVarying: return "varying";
+    case CandidateKind::kTiming: return "timing";
     case CandidateKind::kRoadProfile: return "road profile";
     case CandidateKind::kDictionary: return "dictionary";
   }
@@ -243,7 +338,7 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
   for (const GroupFit& g : result.fit.groups) weights.push_back(g.sigma > 0.0 ? 1.0 / g.sigma : 0.0);
   FitOptions fold_options = options.fit;
   fold_options.series = false;
-  const detail::RowSelection declared_rows = detail::kept_rows(model, declared, run, odmf);
+  const detail::RowSelection declared_rows = detail::kept_rows(model, declared, run, sample_rate_hz, odmf);
   for (const Candidate& c : candidates_of(model, declared, run, sample_rate_hz, options)) {
     std::vector<std::string> with = declared;
     with.push_back(c.effect);
@@ -260,7 +355,41 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
       result.candidates.push_back(std::move(s));
     }
   }
+  const DelayContext delays{model, declared, run, sample_rate_hz, odmf, fold_options, declared_rows, weights};
+  if (options.delays && options.only.empty()) {
+    const Eigen::VectorXd x0 = detail::base_solution(result.fit.estimate);
+    for (const std::string& channel : delay_channels(model, run, declared)) {
+      try {
+        result.candidates.push_back(score_delay(delays, channel, x0));
+      } catch (const InputError& e) {
+        CandidateScore s;
+        s.effect = "delay:" + channel;
+        s.kind = CandidateKind::kTiming;
+        s.note = e.what();
+        result.candidates.push_back(std::move(s));
+      }
+    }
+  }
   decide(result, options.family_error_rate);
+  // A significant delay is located and offered under its name (delay:steer@80ms), with the
+  // score column's standard deviation as the delay's.
+  for (CandidateScore& c : result.candidates) {
+    if (!c.significant || c.effect.rfind("delay:", 0) != 0 || c.effect.find('@') != std::string::npos) continue;
+    const std::string channel = c.effect.substr(6);
+    const auto max = static_cast<Eigen::Index>(std::llround(options.max_delay_s * sample_rate_hz));
+    const Eigen::Index found = locate_delay(delays, channel, max);
+    const double ms_per_sample = 1000.0 / sample_rate_hz;
+    // The delay's std: the score column's at the delay found, refitted there.
+    const detail::FoldedRows at_found = detail::fold_rows(model, with_delay(declared, channel, found, sample_rate_hz),
+                                                          run, sample_rate_hz, odmf, fold_options, false, &declared_rows);
+    const Eigen::VectorXd x_found = detail::base_solution(detail::evaluate(at_found, {}, weights).all);
+    const double std_ms = ms_per_sample * score_delay(delays, channel, x_found, found).coefficient_std;
+    c.effect = delay_effect_name(channel, found, sample_rate_hz);
+    char text[160];
+    std::snprintf(text, sizeof text, "%s is %.0f +- %.0f ms %s", channel.c_str(), std::abs(static_cast<double>(found) * ms_per_sample),
+                  std_ms, found >= 0 ? "late" : "early");
+    c.finding = text;
+  }
   std::stable_sort(result.candidates.begin(), result.candidates.end(), ranks_before);
   prefer_simplest_within_one_error(result.candidates);
   return result;

@@ -7,6 +7,7 @@
 
 #include "dynid/error.hpp"
 #include "dynid/residual/road_profile.hpp"
+#include "dynid/residual/signal_delay.hpp"
 #include "dynid/residual/varying_parameter.hpp"
 
 namespace dynid::residual::detail {
@@ -68,11 +69,12 @@ std::vector<Eigen::Index> decimation_grid(const ingest::PreprocessedSegment& seg
   return kept;
 }
 
-// The effects the model itself builds (a road profile or a varying parameter changes no row).
+// The effects the model itself builds (a road profile, a varying parameter or a delay is
+// fold_rows' own).
 std::vector<std::string> without_profiles(const std::vector<std::string>& effects) {
   std::vector<std::string> out;
   for (const std::string& e : effects)
-    if (!is_road_profile_effect(e) && !is_varying_effect(e)) out.push_back(e);
+    if (!is_road_profile_effect(e) && !is_varying_effect(e) && !is_delay_effect(e)) out.push_back(e);
   return out;
 }
 
@@ -83,8 +85,12 @@ bool listed(const std::vector<Eigen::Index>& sorted, Eigen::Index sample) {
 }  // namespace
 
 RowSelection kept_rows(const model::Model& model, const std::vector<std::string>& effects,
-                       const std::vector<ingest::PreprocessedSegment>& run, int odmf) {
+                       const std::vector<ingest::PreprocessedSegment>& input, double sample_rate_hz, int odmf) {
   const std::vector<std::string> model_effects = without_profiles(effects);
+  std::vector<SignalDelay> delays;
+  for (const std::string& e : effects)
+    if (is_delay_effect(e)) delays.push_back(parse_delay_effect(e, sample_rate_hz));
+  const std::vector<ingest::PreprocessedSegment> run = delays.empty() ? input : delayed(input, delays);
   RowSelection out(run.size(), std::vector<std::vector<Eigen::Index>>(model.groups().size()));
   for (std::size_t s = 0; s < run.size(); ++s) {
     const std::vector<Eigen::Index> kept = decimation_grid(run[s], odmf);
@@ -102,10 +108,13 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   if (odmf < 1) throw InputError("residual analysis: odmf " + std::to_string(odmf) + " < 1");
   std::vector<std::string> model_effects;
   std::vector<VaryingParameter> varying;
+  std::vector<SignalDelay> delays;
   std::string profile_effect;
   for (const std::string& e : effects) {
     if (is_varying_effect(e)) {
       varying.push_back(parse_varying_effect(e, model));
+    } else if (is_delay_effect(e)) {
+      delays.push_back(parse_delay_effect(e, sample_rate_hz));
     } else if (!is_road_profile_effect(e)) {
       model_effects.push_back(e);
     } else if (profile_effect.empty()) {
@@ -138,6 +147,8 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   } else if (is_varying_effect(effects.back())) {
     out.last_effect_first = varying_end - 1;
     out.last_effect_end = varying_end;
+  } else if (is_delay_effect(effects.back())) {  // no column: the rows themselves change
+    out.last_effect_first = out.last_effect_end = width;
   } else {
     const std::vector<std::string> before(model_effects.begin(), model_effects.end() - 1);
     out.last_effect_first = static_cast<Eigen::Index>(model.parameters_with(before).size());
@@ -157,8 +168,11 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   }
   SegmentBuffers buffers(options.cross_validation.folds, group_count);
   std::vector<double> row(static_cast<std::size_t>(width + 1));
-  for (std::size_t s = 0; s < run.size(); ++s) {
-    const ingest::PreprocessedSegment& seg = run[s];
+  const std::vector<ingest::PreprocessedSegment> delayed_run = delays.empty() ? std::vector<ingest::PreprocessedSegment>{}
+                                                                             : delayed(run, delays);
+  const std::vector<ingest::PreprocessedSegment>& rows_run = delays.empty() ? run : delayed_run;
+  for (std::size_t s = 0; s < rows_run.size(); ++s) {
+    const ingest::PreprocessedSegment& seg = rows_run[s];
     const std::vector<Eigen::Index> kept = decimation_grid(seg, odmf);
     if (kept.empty()) continue;
     const std::vector<model::GroupRows> built = model.rows_at(seg.channels, kept, model_effects);
@@ -197,6 +211,59 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   }
   if (out.rows() == 0)
     throw InputError("model " + model.name() + ": no row on the run (masking, or no valid segment)");
+  return out;
+}
+
+GridResiduals residuals_at(const FoldedRows& rows, const Eigen::VectorXd& x) {
+  const auto width = static_cast<Eigen::Index>(rows.parameters.size());
+  GridResiduals out(rows.collected.values.size());
+  for (std::size_t g = 0; g < out.size(); ++g) {
+    const std::vector<double>& v = rows.collected.values[g];
+    const Eigen::Index m = static_cast<Eigen::Index>(v.size()) / (width + 1);
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> all(
+        v.data(), m, width + 1);
+    const Eigen::VectorXd r = all.col(width) - all.leftCols(width) * x;
+    for (Eigen::Index i = 0; i < m; ++i)
+      out[g].emplace_back(rows.collected.grid_index[g][static_cast<std::size_t>(i)], r(i));
+    std::sort(out[g].begin(), out[g].end());
+  }
+  return out;
+}
+
+FoldedRows with_extra_column(const FoldedRows& base, const std::vector<std::vector<double>>& column,
+                             const model::ParameterInfo& info, const CrossValidation& cv) {
+  const auto width = static_cast<Eigen::Index>(base.parameters.size());
+  FoldedRows out;
+  out.parameters = base.parameters;
+  out.parameters.push_back(info);
+  out.groups = base.groups;
+  out.last_effect_first = width;
+  out.last_effect_end = width + 1;
+  out.rows_outside = base.rows_outside;
+  out.folds.assign(static_cast<std::size_t>(cv.folds), ls::EquationGroups(width + 1, out.groups));
+  out.collected.time_s.resize(base.groups.size());
+  out.collected.grid_index.resize(base.groups.size());
+  out.collected.values.resize(base.groups.size());
+  SegmentBuffers buffers(cv.folds, base.groups.size());
+  std::vector<double> row(static_cast<std::size_t>(width + 2));
+  for (std::size_t g = 0; g < base.groups.size(); ++g) {
+    const std::vector<double>& v = base.collected.values[g];
+    for (std::size_t i = 0; i < base.collected.time_s[g].size(); ++i) {
+      if (!std::isfinite(column[g][i])) continue;
+      const double* source = v.data() + i * static_cast<std::size_t>(width + 1);
+      std::copy(source, source + width, row.begin());
+      row[static_cast<std::size_t>(width)] = column[g][i];
+      row.back() = source[width];
+      const double t = base.collected.time_s[g][i];
+      auto& dest = buffers.values[static_cast<std::size_t>(cv.fold_of(t))][g];
+      dest.insert(dest.end(), row.begin(), row.end());
+      out.collected.time_s[g].push_back(t);
+      out.collected.grid_index[g].push_back(base.collected.grid_index[g][i]);
+      out.collected.values[g].insert(out.collected.values[g].end(), row.begin(), row.end());
+    }
+  }
+  buffers.fold_into(out.folds, width + 1);
+  if (out.rows() == 0) throw InputError("residual analysis: no row left for '" + info.name + "'");
   return out;
 }
 

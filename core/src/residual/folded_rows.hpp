@@ -4,6 +4,7 @@
 // held out) on any prefix-free column selection. Contracts of the public headers apply.
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -51,10 +52,10 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
                      int odmf, const FitOptions& options, bool collect,
                      const RowSelection* only = nullptr);
 
-/// The rows `model` with `effects` (a road profile among them changes no row) keeps on the
-/// decimation grid of `run`. Throws InputError as fold_rows.
+/// The rows `model` with `effects` (a road profile or a varying parameter among them changes no
+/// row; a delay does) keeps on the decimation grid of `run`. Throws InputError as fold_rows.
 RowSelection kept_rows(const model::Model& model, const std::vector<std::string>& effects,
-                       const std::vector<ingest::PreprocessedSegment>& run, int odmf);
+                       const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz, int odmf);
 
 struct Evaluation {
   ls::Estimate all;
@@ -76,6 +77,16 @@ struct Evaluation {
 /// rows.groups (empty: the in-sample fit's own DYCARO weights).
 Evaluation evaluate(const FoldedRows& rows, const std::vector<Eigen::Index>& columns,
                     const std::vector<double>& weights);
+
+/// The residual y - W x of every collected row, per group, with its grid index (increasing).
+using GridResiduals = std::vector<std::vector<std::pair<Eigen::Index, double>>>;
+GridResiduals residuals_at(const FoldedRows& rows, const Eigen::VectorXd& x);
+
+/// `base` (collected) with one more column, `column[g][i]` for collected row i of group g
+/// (NaN: the row is left out), folded again into the cross-validation folds of `cv`. The new
+/// column is the last effect.
+FoldedRows with_extra_column(const FoldedRows& base, const std::vector<std::vector<double>>& column,
+                             const model::ParameterInfo& info, const CrossValidation& cv);
 
 /// The solution with NaN (not identifiable) entries set to 0: the base-parameter solution.
 Eigen::VectorXd base_solution(const ls::Estimate& estimate);

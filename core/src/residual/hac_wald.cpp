@@ -176,6 +176,7 @@ WaldTest hac_wald_test(const FoldedRows& rows, const Eigen::VectorXd& x, const s
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(v);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || (ldlt.vectorD().array() <= 0.0).any()) return result;
   result.statistic = b.dot(ldlt.solve(b));
+  result.first_std = std::sqrt(v(0, 0));
   result.testable = std::isfinite(result.statistic);
   if (result.testable)
     result.p_value = boost::math::cdf(boost::math::complement(

@@ -26,6 +26,7 @@ struct WaldTest {
   int degrees_of_freedom = 0;  ///< the tested columns that are identifiable
   double p_value = 1.0;
   int bandwidth = 0;      ///< Newey-West lags, in decimated rows
+  double first_std = 0.0; ///< HAC standard deviation of the first tested coefficient
 };
 
 /// Tests columns [first, end) of `rows` (collected: fold_rows with collect) at the weighted

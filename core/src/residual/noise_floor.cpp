@@ -130,25 +130,6 @@ double level_relative_variance(const BandPsd& psd, double cutoff, double level) 
   return level > 0.0 ? variance / (level * level) : 0.0;
 }
 
-// The residual y - W x of every collected row, per group, with its grid index (increasing).
-using GridResiduals = std::vector<std::vector<std::pair<Eigen::Index, double>>>;
-
-GridResiduals residuals_at(const detail::FoldedRows& rows, const Eigen::VectorXd& x) {
-  const auto width = static_cast<Eigen::Index>(rows.parameters.size());
-  GridResiduals out(rows.collected.values.size());
-  for (std::size_t g = 0; g < out.size(); ++g) {
-    const std::vector<double>& v = rows.collected.values[g];
-    const Eigen::Index m = static_cast<Eigen::Index>(v.size()) / (width + 1);
-    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> all(
-        v.data(), m, width + 1);
-    const Eigen::VectorXd r = all.col(width) - all.leftCols(width) * x;
-    for (Eigen::Index i = 0; i < m; ++i)
-      out[g].emplace_back(rows.collected.grid_index[g][static_cast<std::size_t>(i)], r(i));
-    std::sort(out[g].begin(), out[g].end());
-  }
-  return out;
-}
-
 // What one draw's noise did to the residual, at the rows both runs keep.
 std::vector<std::pair<Eigen::Index, double>> difference(const std::vector<std::pair<Eigen::Index, double>>& noisy,
                                                         const std::vector<std::pair<Eigen::Index, double>>& base) {
@@ -257,8 +238,8 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
   fit_options.series = false;
   const detail::FoldedRows base = detail::fold_rows(model, effects, segments, rate, odmf, fit_options, true);
   const Eigen::VectorXd x = detail::evaluate(base, {}, {}).x;
-  const GridResiduals r0 = residuals_at(base, x);
-  const detail::RowSelection rows = detail::kept_rows(model, effects, segments, odmf);
+  const detail::GridResiduals r0 = detail::residuals_at(base, x);
+  const detail::RowSelection rows = detail::kept_rows(model, effects, segments, rate, odmf);
   // One channel at a time: the floor is the sum of the channels' shares, and each share's
   // uncertainty (its sigma's, measured) is carried on its own. A channel the model does not
   // read leaves the residual exactly unchanged at the first draw and gets no more.
@@ -272,8 +253,8 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
     std::vector<LagSums> sums(r0.size());
     for (int d = 0; d < options.draws; ++d) {
       const auto noisy = ingest::preprocess_offline(with_noise(run, column, c.sigma, rng));
-      const GridResiduals r1 =
-          residuals_at(detail::fold_rows(model, effects, noisy, rate, odmf, fit_options, true, &rows), x);
+      const detail::GridResiduals r1 =
+          detail::residuals_at(detail::fold_rows(model, effects, noisy, rate, odmf, fit_options, true, &rows), x);
       for (std::size_t g = 0; g < sums.size(); ++g) sums[g].add(difference(r1[g], r0[g]), odmf);
       if (d == 0 && std::all_of(sums.begin(), sums.end(), [](const LagSums& l) { return l.square == 0.0; })) break;
     }

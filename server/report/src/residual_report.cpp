@@ -49,6 +49,8 @@ std::string format_screen_text(const residual::ScreenResult& screen, std::size_t
   out += fmt::format("each candidate tested at level {:.2g} ({} candidates, family error rate {:.2g})\n",
                      screen.level, screen.tests, screen.level * screen.tests);
   if (shown > top) out += fmt::format("... and {} more tested\n", shown - top);
+  for (const residual::CandidateScore& c : screen.candidates)
+    if (!c.finding.empty()) out += fmt::format("{}: {}\n", c.effect, c.finding);
   for (const auto& [reason, count] : untested) out += fmt::format("not tested ({}): {}\n", count, reason);
   return out + "verdict: " + screen.verdict() + "\n";
 }
@@ -139,7 +141,8 @@ json candidate_json(const residual::CandidateScore& c) {
           {"wald_statistic", finite(c.wald_statistic)},
           {"p_value", finite(c.p_value)},
           {"testable", c.testable},
-          {"significant", c.significant}};
+          {"significant", c.significant},
+          {"finding", c.finding}};
 }
 
 json diagnosis_object(const residual::Diagnosis& d) {
