@@ -3,8 +3,7 @@
 #include <cmath>
 #include <dynid/can/dbc.hpp>
 #include <dynid/error.hpp>
-#include <fstream>
-#include <sstream>
+#include <dynid/input/input_file.hpp>
 #include <unordered_set>
 
 #include "dbc_finalize.hpp"
@@ -590,12 +589,7 @@ Database parse_dbc_string(std::string_view text, std::string_view name) {
 }
 
 Database parse_dbc_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open the DBC file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(path.string() + ": read error");
-  return parse_dbc_string(text.str(), path.filename().string());
+  return parse_dbc_string(input::read_input_file(path, "DBC file"), path.filename().string());
 }
 
 }  // namespace dynid::can
