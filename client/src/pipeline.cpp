@@ -9,6 +9,8 @@ ResamplerConfig resampler_config(const VehicleProfile& p) {
   c.channels = p.channels.size();
   c.max_gap_periods = p.max_gap_periods;
   for (const auto& m : p.channels) c.max_gap.push_back(m.max_gap);
+  c.jumps.forward = p.max_time_jump;
+  c.jumps.backward = c.max_latency;  // older frames could only join rows already emitted
   return c;
 }
 
@@ -16,7 +18,8 @@ ResamplerConfig resampler_config(const VehicleProfile& p) {
 
 CarPipeline::CarPipeline(const VehicleProfile& profile, const std::string& run,
                          ChunkBuilder::ChunkSink sink, std::uint64_t first_sequence)
-    : mapper_(profile),
+    : time_jumps_(resampler_config(profile).jumps),
+      mapper_(profile),
       builder_(profile.vehicle, run, profile.channels.size(), profile.chunk_rows, std::move(sink),
                first_sequence),
       resampler_(resampler_config(profile),
