@@ -29,7 +29,7 @@ CarPipeline::CarPipeline(const VehicleProfile& profile, const std::string& run,
 
 void CarPipeline::on_frame(const can::Frame& frame) {
   samples_.clear();
-  mapper_.map(frame, samples_);
+  if (mapper_.map(frame, samples_) == FrameOutcome::BadTime) return;  // not a time the grid can hold
   for (const auto& s : samples_) resampler_.push(s.channel, s.time, s.value);
   // Every frame moves the clock, so a silent channel is declared stale in time.
   resampler_.advance_clock(frame.timestamp);

@@ -19,7 +19,7 @@ ReplayProgress counts(const FrameSource& source, const MapStats& m) {
   p.decoded = m.decoded();
   p.mapped = m.mapped;
   p.unknown_id = m.unknown_id;
-  p.bad = source.bad_input() + m.short_payload + m.remote + m.non_finite;
+  p.bad = source.bad_input() + m.short_payload + m.remote + m.non_finite + m.bad_time;
   p.other_interface = m.other_interface;
   p.fraction = source.fraction_done();
   return p;
@@ -45,7 +45,7 @@ ReplayProgress replay(FrameSource& source, CarPipeline& pipeline, const ReplayOp
   const auto start = Clock::now();
   auto next_report = start + options.progress_interval;
   while (source.next(frame, std::chrono::milliseconds(0)) == NextStatus::Frame) {
-    log_clock.step(frame.timestamp);
+    if (usable_time(frame.timestamp)) log_clock.step(frame.timestamp);  // else the mapper drops it
     const double elapsed = log_clock.elapsed();
     if (options.max_log_seconds && elapsed > *options.max_log_seconds) break;
     log_seconds = elapsed;

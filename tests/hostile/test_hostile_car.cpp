@@ -122,6 +122,30 @@ TEST(HostileCar, ClockJumpsAtEveryScaleCostBoundedRowsAndKeepTheData) {
       }
 }
 
+// A timestamp where a double no longer resolves a grid period (at 1e299 s, t + 0.01 == t) made the
+// grid loop on one row, writing chunks until the disk was full; one at -1 s, or past 1e10 s
+// (the year 2286), is dropped and counted, the rest of the log replayed as usual.
+TEST(HostileCar, FramesAtAbsurdTimesAreDroppedAndCounted) {
+  ScratchDir scratch("hostile-absurd-time");
+  const auto frames = at_epoch(simulated_frames());
+  std::ostringstream text;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    std::string line = can::format_candump_line(frames[i]);
+    if (i == frames.size() / 3) line = "(" + std::string(300, '9') + line.substr(line.find('.'));
+    if (i == frames.size() / 2) line = "(10000000001" + line.substr(line.find('.'));
+    text << line << "\n";
+  }
+  const auto log = scratch.path() / "can.log";
+  const auto out = scratch.path() / "run.chunks";
+  write_text(log, text.str());
+  const Outcome o = run(Program::Car, {"--profile", testcar_profile().string(), "--run", "r1", "--replay", log.string(),
+                                       "--fast", "--chunks-out", out.string()},
+                        scratch, 20s);
+  ASSERT_EQ(o.exit, 0) << describe(o);
+  EXPECT_NE(o.output.find("2 timestamps out of range"), std::string::npos) << describe(o);
+  EXPECT_LE(car::read_chunk_file(out).size(), baseline().chunks.size() + 1);
+}
+
 // Case 5 of issue 19: random bytes, or lines that are not candump lines, ended "0 frames, exit 0".
 TEST(HostileCar, AFileThatIsNoCanLogFailsNamingItAndWritesNothing) {
   ScratchDir scratch("hostile-not-a-log");

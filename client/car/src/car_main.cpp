@@ -161,8 +161,9 @@ std::string replay_log(const Options& options, CarPipeline& pipe,
   ro.progress_interval = 100ms;  // also how often acknowledgements are taken while replaying
   ro.on_progress = std::move(on_progress);
   const ReplayProgress done = replay(source, pipe, ro);
-  spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids), {:.1f} s of log, {} jumps of its clock, {} chunks",
-               done.frames, source.bad_input(), done.unknown_id, done.log_seconds,
+  spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids, {} timestamps out of range), {:.1f} s of "
+               "log, {} jumps of its clock, {} chunks",
+               done.frames, source.bad_input(), done.unknown_id, pipe.mapper_stats().bad_time, done.log_seconds,
                pipe.resampler_stats().pieces_ended, done.chunks);
   for (const auto& e : source.errors()) spdlog::warn("{}", e);
   const std::string problem = replay_problem(done);

@@ -31,7 +31,7 @@ struct ReplayProgress {
   std::uint64_t decoded = 0;          ///< frames the DBC decoded (mapped or not)
   std::uint64_t mapped = 0;           ///< frames that gave a channel of the profile
   std::uint64_t unknown_id = 0;
-  std::uint64_t bad = 0;              ///< bad lines + short payloads + remote frames + NaN values
+  std::uint64_t bad = 0;  ///< bad lines + short payloads + remote frames + NaN values + bad times
   std::uint64_t other_interface = 0;  ///< frames of buses the profile ignores
   std::uint64_t rows = 0;
   std::uint64_t invalid_rows = 0;

@@ -15,6 +15,9 @@
 //   only on the samples, not on how they were batched. Event-driven (send-on-change) signals do
 //   not fit this rule: give them max_gap.
 //
+// Times are seconds within [0, kMaxTimestamp] (signal_mapper.hpp drops frames outside it), where
+// a double resolves every grid period.
+//
 // Streaming and latency: the clock is the newest timestamp seen (push or advance_clock, which
 // the pipeline calls for every frame, mapped or not). Row k is emitted, in order, as soon as
 // every channel has decided it: it has a sample at or after t_k, or the clock has reached t_k and
