@@ -35,7 +35,7 @@ class Reader {
     if (node != nullptr && node->source().begin.line > 0)
       where += ":" + std::to_string(node->source().begin.line) + ":" +
                std::to_string(node->source().begin.column);
-    throw InputError(where + ": " + key + ": " + reason);
+    throw InputError(where + ": " + input::printable_text(key + ": " + reason));  // the file's text, escaped
   }
 
   const toml::table& table(const toml::table& parent, const std::string& key,

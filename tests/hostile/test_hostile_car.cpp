@@ -181,6 +181,8 @@ TEST(HostileCar, AFileThatIsNoCanLogFailsNamingItAndWritesNothing) {
     EXPECT_NE(o.output.find(log.string() + ": not a CAN log this profile can use"), std::string::npos)
         << describe(o);
     EXPECT_FALSE(std::filesystem::exists(out)) << "nothing is written for a file that is no log";
+    for (const char c : o.output)  // the file's bytes are shown escaped
+      ASSERT_TRUE(c == '\n' || (c >= 0x20 && c < 0x7f)) << "unescaped byte " << int(c) << " in " << describe(o);
   }
 }
 

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <dynid/can/candump.hpp>
 #include <dynid/error.hpp>
+#include <dynid/input/ids.hpp>
 #include <dynid/input/input_file.hpp>
 #include <istream>
 #include <ostream>
@@ -37,7 +38,8 @@ std::string_view next_word(std::string_view& s) {
   return w;
 }
 
-std::string quoted(std::string_view s) { return "'" + std::string(s.substr(0, 40)) + "'"; }
+// Escaped: a log's bytes reach messages and log lines (input/ids.hpp printable()).
+std::string quoted(std::string_view s) { return "'" + input::printable(s.substr(0, 40)) + "'"; }
 
 std::string parse_timestamp(std::string_view word, Frame& f) {
   if (word.size() < 3 || word.front() != '(' || word.back() != ')')

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <dynid/can/dbc.hpp>
 #include <dynid/error.hpp>
+#include <dynid/input/ids.hpp>
 #include <dynid/input/input_file.hpp>
 #include <unordered_set>
 
@@ -50,8 +51,9 @@ class Parser {
   bool at_line_end() const { return peek().opens_line; }
 
   [[noreturn]] void fail(const Token& at, std::string_view reason) const {
-    throw InputError(name_ + ":" + std::to_string(at.line) + ": " + context_ + ": " +
-                     std::string(reason));
+    // Escaped: the file's bytes (names, tokens) reach the message.
+    throw InputError(name_ + ":" + std::to_string(at.line) + ": " +
+                     input::printable_text(context_ + ": " + std::string(reason)));
   }
   [[noreturn]] void fail_expected(std::string_view what) const {
     fail(peek(), "expected " + std::string(what) + ", found " + detail::describe(peek()));
@@ -302,7 +304,7 @@ class Parser {
     return nullptr;
   }
   void warn(const Token& at, const std::string& what) {
-    db_.warnings.push_back(name_ + ":" + std::to_string(at.line) + ": " + context_ + ": " + what);
+    db_.warnings.push_back(name_ + ":" + std::to_string(at.line) + ": " + input::printable_text(context_ + ": " + what));
   }
 
   // Where a CM_ or BA_ applies: the network, a node, a message, a signal or a variable.

@@ -51,4 +51,11 @@ std::string printable(std::string_view text) {
   return out;
 }
 
+std::string printable_text(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) out += c == '\\' || c == '\'' ? std::string(1, c) : escaped(c);
+  return out;
+}
+
 }  // namespace dynid::input

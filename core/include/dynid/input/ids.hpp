@@ -11,7 +11,9 @@
 // Contract: check_vehicle_id / check_run_name throw InputError "<what> '<id, escaped>': <reason>"
 // (the first offending character and its position, or the length). printable() is what a message
 // shows of text that failed (or may fail) the rule: printable ASCII as it is, any other byte as
-// \xNN, a backslash or quote escaped, at most kMaxShown bytes followed by "...".
+// \xNN, a backslash or quote escaped, at most kMaxShown bytes followed by "...". printable_text()
+// is the same for a whole message built from a file's text (a DBC or profile error): only the
+// bytes outside printable ASCII are escaped, nothing is cut.
 #include <cstddef>
 #include <string>
 #include <string_view>
@@ -31,5 +33,6 @@ inline void check_run_name(std::string_view id) { check_id("run name", id); }
 
 /// `text` safe for a message or a log line (see the contract above).
 std::string printable(std::string_view text);
+std::string printable_text(std::string_view text);
 
 }  // namespace dynid::input
