@@ -227,6 +227,22 @@ TEST(HostileCar, InputsThatAreNotRegularFilesAreRefusedAtOnce) {
   }
 }
 
+// A bus that cannot be read (a name no interface can have, one that does not exist, or a kernel
+// without SocketCAN) fails before the chunk file is created.
+TEST(HostileCar, ABusThatCannotBeReadLeavesNoChunkFile) {
+  ScratchDir scratch("hostile-bus");
+  const auto out = scratch.path() / "out.chunks";
+  for (const std::string& name : {std::string(40, 'x'), std::string("a/b"), std::string("none0")}) {
+    SCOPED_TRACE(name);
+    const Outcome o = run(Program::Car, {"--profile", testcar_profile().string(), "--run", "r1", "--can", name,
+                                         "--chunks-out", out.string()},
+                          scratch, 5s);
+    EXPECT_EQ(o.exit, 1) << describe(o);
+    EXPECT_NE(o.output.find("SocketCAN"), std::string::npos) << describe(o);
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+}
+
 // /dev/zero never ends: as a log it was read without end (memory grew with it); a sparse file of
 // zeros is a regular file but would be one endless line.
 TEST(HostileCar, EndlessInputIsRefusedOrReadInBoundedTime) {

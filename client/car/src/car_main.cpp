@@ -170,11 +170,12 @@ std::string replay_log(const Options& options, CarPipeline& pipe,
   return problem.empty() ? problem : log_problem(options, source, problem);
 }
 
-// Reads options.can live into the pipeline until a signal (or options.max_frames frames), then
-// finishes it. `service` runs about every 100 ms (acknowledgements, progress). Both the delivering
-// client and --chunks-out read the bus through this loop.
-void read_bus(const Options& options, CarPipeline& pipe, const std::function<void(const CarPipeline&)>& service) {
-  SocketCanSource source(options.can);
+// Reads the bus (options.can, opened by the caller) live into the pipeline until a signal (or
+// options.max_frames frames), then finishes it. `service` runs about every 100 ms
+// (acknowledgements, progress). Both the delivering client and --chunks-out read the bus
+// through this loop.
+void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe,
+              const std::function<void(const CarPipeline&)>& service) {
   g_live.store(&source);
   struct Unregister {
     ~Unregister() { g_live.store(nullptr); }
@@ -245,7 +246,8 @@ struct Session {
   void read_bus_run(const std::string& run) {
     CarPipeline pipe = pipeline(run);
     source_name = "live " + options.can;
-    read_bus(options, pipe, [&](const CarPipeline& p) {
+    SocketCanSource source(options.can);
+    read_bus(options, source, pipe, [&](const CarPipeline& p) {
       delivery.service(0ms);
       ReplayProgress progress;
       progress.frames = p.mapper_stats().frames;
@@ -306,6 +308,9 @@ struct Session {
 int write_chunks(const Options& options) {
   const VehicleProfile profile = load_vehicle_profile(options.profile);
   if (!options.replay.empty()) probe_log(options, profile);
+  // The source is opened before the chunk file is created: a bus that cannot be read leaves none.
+  std::optional<SocketCanSource> live;
+  if (options.replay.empty()) live.emplace(options.can);
   const std::string run = options.run.empty() ? default_run_id() : options.run;
   ChunkFileWriter writer(options.chunks_out);
   CarPipeline pipe(profile, run, [&writer](dynid::ingest::Chunk&& chunk) { writer.write(chunk); });
@@ -318,7 +323,7 @@ int write_chunks(const Options& options) {
         if (g_stop.load()) throw Interrupted{};
       });
     } else {
-      read_bus(options, pipe, [](const CarPipeline&) {});
+      read_bus(options, *live, pipe, [](const CarPipeline&) {});
     }
   } catch (const Interrupted&) {
     spdlog::warn("interrupted: {} chunks written to {}", writer.chunks(), options.chunks_out);
