@@ -1,11 +1,15 @@
 #include "dynid/car/candump_source.hpp"
 
+#include <dynid/input/input_file.hpp>
+
 #include "dynid/error.hpp"
 
 namespace dynid::car {
 namespace {
 
+// Checked before opening: opening a FIFO would block until a writer appears.
 std::ifstream open_log(const std::filesystem::path& path) {
+  input::check_input_file(path, "CAN log");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string() + ": cannot open the CAN log");
   return in;
@@ -13,10 +17,12 @@ std::ifstream open_log(const std::filesystem::path& path) {
 
 }  // namespace
 
-CandumpSource::CandumpSource(const std::filesystem::path& path)
+CandumpSource::CandumpSource(const std::filesystem::path& path, std::size_t max_bad_lines)
     : file_(open_log(path)),
       size_(std::filesystem::file_size(path)),
-      reader_(file_, path.filename().string(), can::OnError::Continue) {}
+      reader_(file_, path.filename().string(), can::OnError::Continue) {
+  reader_.stop_after_errors(max_bad_lines);
+}
 
 NextStatus CandumpSource::next(can::Frame& frame, std::chrono::milliseconds /*timeout*/) {
   if (ended_ || !reader_.next(frame)) {

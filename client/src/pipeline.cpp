@@ -9,6 +9,8 @@ ResamplerConfig resampler_config(const VehicleProfile& p) {
   c.channels = p.channels.size();
   c.max_gap_periods = p.max_gap_periods;
   for (const auto& m : p.channels) c.max_gap.push_back(m.max_gap);
+  c.jumps.forward = p.max_time_jump;
+  c.jumps.backward = c.max_latency;  // older frames could only join rows already emitted
   return c;
 }
 
@@ -16,7 +18,8 @@ ResamplerConfig resampler_config(const VehicleProfile& p) {
 
 CarPipeline::CarPipeline(const VehicleProfile& profile, const std::string& run,
                          ChunkBuilder::ChunkSink sink, std::uint64_t first_sequence)
-    : mapper_(profile),
+    : time_jumps_(resampler_config(profile).jumps),
+      mapper_(profile),
       builder_(profile.vehicle, run, profile.channels.size(), profile.chunk_rows, std::move(sink),
                first_sequence),
       resampler_(resampler_config(profile),
@@ -26,7 +29,7 @@ CarPipeline::CarPipeline(const VehicleProfile& profile, const std::string& run,
 
 void CarPipeline::on_frame(const can::Frame& frame) {
   samples_.clear();
-  mapper_.map(frame, samples_);
+  if (mapper_.map(frame, samples_) == FrameOutcome::BadTime) return;  // not a time the grid can hold
   for (const auto& s : samples_) resampler_.push(s.channel, s.time, s.value);
   // Every frame moves the clock, so a silent channel is declared stale in time.
   resampler_.advance_clock(frame.timestamp);

@@ -23,22 +23,48 @@ void check_config(const ResamplerConfig& c) {
 }  // namespace
 
 Resampler::Resampler(ResamplerConfig config, RowSink sink)
-    : config_(std::move(config)), sink_(std::move(sink)) {
+    : config_(std::move(config)), sink_(std::move(sink)), source_clock_(config_.jumps) {
   check_config(config_);
   if (config_.max_gap.empty()) config_.max_gap.resize(config_.channels);
   channels_.resize(config_.channels);
   row_.resize(config_.channels);
   stats_.missing_by_channel.assign(config_.channels, 0);
-  origin_ = config_.origin;
+  origin_ = first_origin_ = config_.origin;
 }
 
 double Resampler::row_time(std::uint64_t k) const {
-  return *origin_ + static_cast<double>(k) / config_.rate_hz;
+  return *origin_ + static_cast<double>(k - piece_first_row_) / config_.rate_hz;
+}
+
+// Every frame time goes through the source clock: a jump ends the piece before the time is used.
+void Resampler::observe(double time) {
+  if (source_clock_.step(time)) end_piece();
+}
+
+void Resampler::start_piece(double time) {
+  origin_ = time;
+  if (!first_origin_) first_origin_ = time;
+  piece_first_row_ = next_row_;
+}
+
+void Resampler::end_piece() {
+  if (origin_) {
+    emit_reached();
+    if (last_valid_) {  // the break, so that no valid segment spans it
+      for (auto& missing : stats_.missing_by_channel) ++missing;
+      deliver(false);
+    }
+    ++stats_.pieces_ended;
+  }
+  origin_.reset();
+  std::fill(channels_.begin(), channels_.end(), Channel{});
+  clock_ = -std::numeric_limits<double>::infinity();
 }
 
 void Resampler::push(std::size_t channel, double time, double value) {
   ++stats_.samples;
-  if (!origin_) origin_ = time;
+  observe(time);
+  if (!origin_) start_piece(time);
   Channel& c = channels_.at(channel);
   if (!c.samples.empty() && !(time > c.samples.back().time)) {
     ++stats_.out_of_order;
@@ -55,6 +81,13 @@ void Resampler::push(std::size_t channel, double time, double value) {
 }
 
 void Resampler::advance_clock(double time) {
+  observe(time);
+  clock_ = std::max(clock_, time);
+  emit_ready();
+}
+
+void Resampler::idle(double time) {
+  if (origin_ && source_clock_.silent_at(time)) end_piece();
   clock_ = std::max(clock_, time);
   emit_ready();
 }
@@ -115,7 +148,10 @@ void Resampler::emit_ready() {
   }
 }
 
-void Resampler::finish() {
+void Resampler::finish() { emit_reached(); }
+
+// The rows every channel with data has reached (the end of a run or of a piece).
+void Resampler::emit_reached() {
   if (!origin_) return;
   emit_ready();
   double end = 0.0;
@@ -138,13 +174,18 @@ void Resampler::emit_row(double t) {
       ++stats_.missing_by_channel[i];
     }
   }
+  deliver(valid);
+  const double next = row_time(next_row_);
+  for (auto& c : channels_) prune(c, next);
+}
+
+void Resampler::deliver(bool valid) {
   if (!valid) std::fill(row_.begin(), row_.end(), 0.0);  // an invalid row carries zeros
   ++stats_.rows;
   if (!valid) ++stats_.invalid_rows;
+  last_valid_ = valid;
   sink_(next_row_, row_, valid);
   ++next_row_;
-  const double next = row_time(next_row_);
-  for (auto& c : channels_) prune(c, next);
 }
 
 // Keeps the last sample at or before `t` (the lower bracket of the next row) and all after it.

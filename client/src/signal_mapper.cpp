@@ -12,6 +12,10 @@ SignalMapper::SignalMapper(const VehicleProfile& profile) : profile_(profile), d
 
 FrameOutcome SignalMapper::map(const can::Frame& frame, std::vector<ChannelSample>& out) {
   ++stats_.frames;
+  if (!usable_time(frame.timestamp)) {
+    ++stats_.bad_time;
+    return FrameOutcome::BadTime;
+  }
   // Another bus may reuse an id of this DBC with another meaning (the RAV4's radar bus does).
   if (!profile_.accepts_interface(frame.interface_name())) {
     ++stats_.other_interface;

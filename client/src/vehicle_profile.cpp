@@ -1,13 +1,14 @@
 #include "dynid/car/vehicle_profile.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <initializer_list>
 #include <set>
 #include <sstream>
 
 #include <toml++/toml.h>
 
+#include <dynid/input/ids.hpp>
+#include <dynid/input/input_file.hpp>
 #include <dynid/model/registry.hpp>
 
 #include "dynid/model/channel_catalogue.hpp"
@@ -15,6 +16,12 @@
 
 namespace dynid::car {
 namespace {
+
+// Limits of the grid's numbers: a car's CAN signals come at most at a few kHz; a chunk is one
+// wire sample (dynid_wire_kMaxRows); a gap or jump limit beyond an hour is a typing error.
+constexpr double kMaxRateHz = 10000.0;
+constexpr std::size_t kMaxChunkRows = 10000;
+constexpr double kMaxSeconds = 3600.0;
 
 // Reads one profile file: every failure names the file, the line:column of the offending node
 // when there is one, the key and the reason.
@@ -28,7 +35,7 @@ class Reader {
     if (node != nullptr && node->source().begin.line > 0)
       where += ":" + std::to_string(node->source().begin.line) + ":" +
                std::to_string(node->source().begin.column);
-    throw InputError(where + ": " + key + ": " + reason);
+    throw InputError(where + ": " + input::printable_text(key + ": " + reason));  // the file's text, escaped
   }
 
   const toml::table& table(const toml::table& parent, const std::string& key,
@@ -52,6 +59,12 @@ class Reader {
     if (!n.is_number()) fail(full, "expected a number", &n);
     const double v = *n.value<double>();
     if (!std::isfinite(v)) fail(full, "must be finite", &n);
+    return v;
+  }
+
+  double at_most(const toml::table& t, const std::string& key, const std::string& full, double limit) const {
+    const double v = positive(t, key, full);
+    if (v > limit) fail(full, "must be at most " + std::to_string(limit), t.get(key));
     return v;
   }
 
@@ -100,6 +113,8 @@ void read_vehicle(const Reader& r, const toml::table& root, VehicleProfile& p) {
   const toml::table& v = r.table(root, "vehicle");
   r.only_keys(v, {"id", "dbc", "interfaces"}, "vehicle.");
   p.vehicle = r.string(v, "id", "vehicle.id");
+  if (const std::string problem = input::id_problem(p.vehicle); !problem.empty())
+    r.fail("vehicle.id", "'" + input::printable(p.vehicle) + "' " + problem, v.get("id"));
   p.dbc_path = r.relative_path(r.string(v, "dbc", "vehicle.dbc"));
   try {
     p.dbc = std::make_shared<const can::Database>(can::parse_dbc_file(p.dbc_path));
@@ -112,20 +127,24 @@ void read_vehicle(const Reader& r, const toml::table& root, VehicleProfile& p) {
 
 void read_grid(const Reader& r, const toml::table& root, VehicleProfile& p) {
   const toml::table& g = r.table(root, "grid");
-  r.only_keys(g, {"rate_hz", "chunk_seconds", "max_gap_periods"}, "grid.");
-  p.rate_hz = r.positive(g, "rate_hz", "grid.rate_hz");
+  r.only_keys(g, {"rate_hz", "chunk_seconds", "max_gap_periods", "max_time_jump"}, "grid.");
+  p.rate_hz = r.at_most(g, "rate_hz", "grid.rate_hz", kMaxRateHz);
   const double seconds = r.positive(g, "chunk_seconds", "grid.chunk_seconds");
   const double rows = seconds * p.rate_hz;
   if (std::abs(rows - std::round(rows)) > 1e-9 * rows || std::round(rows) < 1.0)
     r.fail("grid.chunk_seconds", "must be a whole number (>= 1) of grid periods (1/rate_hz), got " +
                                      std::to_string(rows) + " periods", g.get("chunk_seconds"));
+  if (rows > static_cast<double>(kMaxChunkRows))
+    r.fail("grid.chunk_seconds", std::to_string(rows) + " rows per chunk, at most " + std::to_string(kMaxChunkRows),
+           g.get("chunk_seconds"));
   p.chunk_rows = static_cast<std::size_t>(std::llround(rows));
   if (g.contains("max_gap_periods")) {
-    p.max_gap_periods = r.positive(g, "max_gap_periods", "grid.max_gap_periods");
+    p.max_gap_periods = r.at_most(g, "max_gap_periods", "grid.max_gap_periods", kMaxSeconds);
     if (p.max_gap_periods < 1.0)
       r.fail("grid.max_gap_periods", "must be >= 1 (a gap shorter than one period is no gap)",
              g.get("max_gap_periods"));
   }
+  if (g.contains("max_time_jump")) p.max_time_jump = r.at_most(g, "max_time_jump", "grid.max_time_jump", kMaxSeconds);
 }
 
 void read_spool(const Reader& r, const toml::table& root, VehicleProfile& p) {
@@ -275,7 +294,7 @@ ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml
     if (!s->is_integer() || (*v != 1 && *v != -1)) r.fail(key + ".sign", "expected 1 or -1", s);
     m.gain *= static_cast<double>(*v);
   }
-  if (t.contains("max_gap")) m.max_gap = r.positive(t, "max_gap", key + ".max_gap");
+  if (t.contains("max_gap")) m.max_gap = r.at_most(t, "max_gap", key + ".max_gap", kMaxSeconds);
   return m;
 }
 
@@ -345,11 +364,7 @@ VehicleProfile parse_vehicle_profile(std::string_view text, const std::filesyste
 }
 
 VehicleProfile load_vehicle_profile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open the vehicle profile");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_vehicle_profile(text.str(), path);
+  return parse_vehicle_profile(input::read_input_file(path, "vehicle profile"), path);
 }
 
 }  // namespace dynid::car

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include <dynid/input/ids.hpp>
+
 #include "dynid/dds/conversions.hpp"
 #include "server_impl.hpp"
 
@@ -148,7 +150,7 @@ void Server::Impl::answer(const dds::Request& request, const ReplyCache::Key& ke
     counters.add(&CounterSnapshot::requests_rejected);
     reply = reply_to(request, dds::ReplyStatus::kBadRequest, e.what());
   } catch (const std::exception& e) {
-    spdlog::error("request {}#{} failed: {}", request.client, request.correlation_id, e.what());
+    spdlog::error("request {}#{} failed: {}", input::printable(request.client), request.correlation_id, e.what());
     reply = reply_to(request, dds::ReplyStatus::kFailed, e.what());
   }
   reply.client = request.client;

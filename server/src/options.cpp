@@ -2,11 +2,13 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <filesystem>
 #include <iostream>
 #include <thread>
 
 #include "dynid/dds/participant.hpp"
 #include "dynid/error.hpp"
+#include "dynid/input/option_checks.hpp"
 
 namespace dynid::server {
 
@@ -17,9 +19,29 @@ unsigned ServerOptions::worker_count() const {
 
 std::string cyclone_config_uri(const std::string& value) {
   if (value.empty()) throw InputError("--cyclone-config: empty (a configuration is required)");
-  if (value.rfind("file://", 0) == 0 || value.front() == '<') return value;
-  return dds::config_file_uri(value);
+  return dds::config_uri(value);
 }
+
+namespace {
+
+// The store is created if absent; an existing path must be a regular file (SQLite on a FIFO
+// or a device would block or fail obscurely).
+CLI::Validator new_or_regular_file() {
+  return CLI::Validator(
+      [](std::string& path) -> std::string {
+        std::error_code ec;
+        if (!std::filesystem::exists(std::filesystem::symlink_status(path, ec))) return {};
+        try {
+          input::check_input_file(path, "store");
+        } catch (const InputError& e) {
+          return e.what();
+        }
+        return {};
+      },
+      "FILE");
+}
+
+}  // namespace
 
 std::optional<ServerOptions> parse_options(int argc, const char* const* argv) {
   ServerOptions o;
@@ -27,19 +49,20 @@ std::optional<ServerOptions> parse_options(int argc, const char* const* argv) {
   long long publish_ms = o.publish_interval.count();
   CLI::App app{"dynid-server: archives measurement chunks, identifies parameters, publishes "
                "estimates over Cyclone DDS"};
-  app.add_option("--store", o.store_path, "SQLite store file")->required();
+  app.add_option("--store", o.store_path, "SQLite store file")->required()->check(new_or_regular_file());
   app.add_option("--cyclone-config", o.cyclone_config,
                  "Cyclone DDS configuration (file, file:// URI or XML)")
       ->required();
   app.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 230));
-  app.add_option("--threads", o.threads, "folding workers (0: one per core)");
+  app.add_option("--threads", o.threads, "folding workers (0: one per core)")
+      ->check(input::within(0, kMaxThreads));
   app.add_option("--checkpoint-every", o.checkpoint_every, "checkpoint every N folded chunks")
-      ->check(CLI::PositiveNumber);
+      ->check(input::within(1, kMaxCheckpointEvery));
   app.add_option("--publish-interval-ms", publish_ms, "minimum time between estimate updates")
-      ->check(CLI::NonNegativeNumber);
+      ->check(input::within(0, kMaxPublishIntervalMs));
   app.add_option("--shard", shard, "own the vehicles whose hash mod N == K (K/N)");
   app.add_option("--reorder-window", o.store.reorder_window, "chunks stored ahead of a gap")
-      ->check(CLI::PositiveNumber);
+      ->check(input::within(1, kMaxReorderWindow));
   app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   try {

@@ -4,6 +4,8 @@
 #include <set>
 #include <stdexcept>
 
+#include <dynid/input/ids.hpp>
+
 #include "dynid/error.hpp"
 
 namespace dynid::server {
@@ -40,6 +42,24 @@ std::string known_kinds() {
   return list;
 }
 
+// Vehicle ids and run names reach the store's queries, partitions and log lines: the id rule
+// (input/ids.hpp) is checked here, before any work.
+void check_ids(const ParsedRequest& parsed, const std::string& where) {
+  const auto check = [&where](const std::string& argument, const std::string& value, bool vehicle) {
+    try {
+      vehicle ? input::check_vehicle_id(value) : input::check_run_name(value);
+    } catch (const InputError& e) {
+      throw InputError(where + ": argument '" + argument + "': " + e.what());
+    }
+  };
+  for (const auto& [name, values] : parsed.arguments)
+    for (const auto& value : values) {
+      if (name == "vehicle" || name == "run") check(name, value, name == "vehicle");
+      if (name == "vehicles")
+        for (const auto& item : split_list(value)) check(name, item, true);
+    }
+}
+
 }  // namespace
 
 std::optional<std::string> ParsedRequest::optional(const std::string& name) const {
@@ -59,15 +79,15 @@ std::vector<std::string> ParsedRequest::all(const std::string& name) const {
 
 ParsedRequest parse_request(const dds::Request& request) {
   const std::string where =
-      "request " + request.client + "#" + std::to_string(request.correlation_id);
+      "request " + input::printable(request.client) + "#" + std::to_string(request.correlation_id);
   const auto spec = kinds().find(request.kind);
   if (spec == kinds().end())
-    throw InputError(where + ": unknown kind '" + request.kind + "' (known: " + known_kinds() + ")");
+    throw InputError(where + ": unknown kind '" + input::printable(request.kind) + "' (known: " + known_kinds() + ")");
   ParsedRequest parsed{request.kind, {}};
   for (const auto& argument : request.arguments) {
     const auto& s = spec->second;
     if (!s.required.count(argument.name) && !s.optional.count(argument.name))
-      throw InputError(where + ": '" + request.kind + "' takes no argument '" + argument.name + "'");
+      throw InputError(where + ": '" + request.kind + "' takes no argument '" + input::printable(argument.name) + "'");
     if (argument.value.empty())
       throw InputError(where + ": argument '" + argument.name + "' is empty");
     auto& values = parsed.arguments[argument.name];
@@ -78,6 +98,7 @@ ParsedRequest parse_request(const dds::Request& request) {
   for (const auto& name : spec->second.required)
     if (!parsed.arguments.count(name))
       throw InputError(where + ": '" + request.kind + "' needs argument '" + name + "'");
+  check_ids(parsed, where);
   // The residual loop's reports come as text, JSON or a self-contained HTML page.
   const bool report = request.kind == "residual" || request.kind == "add-effect" || request.kind == "trace";
   if (const auto format = parsed.optional("format");

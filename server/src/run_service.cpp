@@ -5,6 +5,8 @@
 
 #include <algorithm>
 
+#include <dynid/input/ids.hpp>
+
 #include "dynid/dds/conversions.hpp"
 #include "dynid/report/estimate_report.hpp"
 
@@ -17,7 +19,10 @@ constexpr std::uint64_t kReplayBatch = 16;      // chunks read from the store pe
 constexpr std::size_t kMaxBatch = 256;          // chunks stored per transaction at most
 constexpr std::size_t kMaxInFlight = 2;         // batches a worker has at the committer at most
 
-std::string label(const store::RunKey& key) { return key.vehicle + "/" + key.run; }
+// Escaped: ids come from the network, and a log line must not be forged by one.
+std::string label(const store::RunKey& key) {
+  return input::printable(key.vehicle) + "/" + input::printable(key.run);
+}
 
 std::int64_t as_mark(const std::optional<std::uint64_t>& sequence) {
   return sequence ? static_cast<std::int64_t>(*sequence) : -1;

@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <dynid/input/ids.hpp>
+
 #include "dynid/dds/conversions.hpp"
 #include "dynid/dds/topics.hpp"
 #include "dynid/error.hpp"
@@ -180,7 +182,7 @@ void Server::Impl::send(dds::Reply reply) {
   try {
     replies.write(to_wire(reply).data);
   } catch (const std::exception& e) {
-    spdlog::error("reply to {}#{} not sent: {}", reply.client, reply.correlation_id, e.what());
+    spdlog::error("reply to {}#{} not sent: {}", input::printable(reply.client), reply.correlation_id, e.what());
   }
 }
 

@@ -2,6 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <stdexcept>
+#include <system_error>
+
 #include "dynid/server/shard.hpp"
 
 namespace dynid::server {
@@ -13,7 +16,15 @@ WorkerPool::WorkerPool(std::size_t workers, std::size_t max_queue,
       tick_(std::move(tick)) {
   for (std::size_t k = 0; k < std::max<std::size_t>(1, workers); ++k)
     queues_.push_back(std::make_unique<Queue>());
-  for (std::size_t k = 0; k < queues_.size(); ++k) threads_.emplace_back([this, k] { run(k); });
+  try {
+    for (std::size_t k = 0; k < queues_.size(); ++k) threads_.emplace_back([this, k] { run(k); });
+  } catch (const std::system_error& e) {
+    // The threads already started must end before they are destroyed (else std::terminate).
+    const std::size_t started = threads_.size();
+    stop();
+    throw std::runtime_error("worker pool: cannot start worker " + std::to_string(started + 1) + " of " +
+                             std::to_string(queues_.size()) + ": " + e.what());
+  }
 }
 
 WorkerPool::~WorkerPool() { stop(); }

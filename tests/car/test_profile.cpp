@@ -220,7 +220,7 @@ TEST(CarProfile, SyntaxAndFileErrors) {
     }
     return std::string();
   }();
-  EXPECT_NE(msg.find("does-not-exist.toml: cannot open the vehicle profile"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("does-not-exist.toml: vehicle profile: no such file"), std::string::npos) << msg;
 }
 
 }  // namespace

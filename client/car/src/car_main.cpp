@@ -14,6 +14,10 @@
 // frames (tests/vm). Live timestamps are taken at the microsecond resolution of a candump log
 // (read_bus), which is what makes that comparison exact.
 //
+// A replayed log is judged twice (replay.hpp, replay_problem): its first lines before anything is
+// announced, spooled or written (a file that is no usable log changes nothing), and the whole log
+// at its end (what it held is delivered, and the exit status is 1).
+//
 // Exit status: 0 everything acknowledged (or written); 1 bad arguments or input, or a failure; 2
 // chunks left unacknowledged after --drain-timeout (they stay in the spool for the next start); 3
 // the spool filled up and reading stopped (also with chunks left); 130 interrupted.
@@ -37,6 +41,7 @@
 
 #include <dynid/dds/participant.hpp>
 #include <dynid/error.hpp>
+#include <dynid/input/option_checks.hpp>
 
 #include "dynid/car/candump_source.hpp"
 #include "dynid/car/chunk_file.hpp"
@@ -52,6 +57,7 @@
 namespace {
 
 using namespace dynid::car;
+namespace input = dynid::input;
 using namespace std::chrono_literals;
 
 struct Options {
@@ -73,6 +79,14 @@ struct Options {
 constexpr const char* kLogPattern = "dynid-car %l: %v";
 
 enum Exit { kOk = 0, kFailed = 1, kUndelivered = 2, kSpoolFull = 3, kInterrupted = 130 };
+
+// Limits of the numeric options: beyond them a duration overflows its clock's count, or the
+// value is a typing error (a replay 1000 times faster than real time is --fast anyway).
+constexpr double kMinSpeed = 1e-3;
+constexpr double kMaxSpeed = 1e3;
+constexpr double kMaxSeconds = 86400.0;
+constexpr double kMinAckTimeout = 0.01;
+constexpr double kMaxFrames = 1e12;
 
 // Signals: stop reading (the live source wakes at once), then drain as usual. A second signal
 // ends the process the default way.
@@ -98,13 +112,6 @@ std::string default_run_id() {
   return buf;
 }
 
-// As dynid-server takes it: "file://..." or "<..." (comma-separated, as in CYCLONEDDS_URI) is
-// used as it is, e.g. a file plus a discovery tag; anything else is a path to a file.
-std::string cyclone_uri(const std::string& value) {
-  if (value.rfind("file://", 0) == 0 || value.rfind('<', 0) == 0) return value;
-  return dynid::dds::config_file_uri(value);
-}
-
 // A run id names one recording: reusing one would mix two runs' chunks under one sequence.
 void check_new_run(const Spool& spool, const std::string& vehicle, const std::string& run) {
   bool known = spool.acknowledged(vehicle, run).has_value();
@@ -124,26 +131,51 @@ double at_log_resolution(double seconds) {
   return static_cast<double>(std::llround(seconds * 1e6)) / 1e6;
 }
 
+// Lines of a log judged before anything of it is announced, spooled or written: enough to tell
+// a log from another file at once, few enough that the probe costs nothing (about 5 ms).
+constexpr std::uint64_t kProbeLines = 10000;
+
+// "<file>: <reason>", with the first bad line's reason when there is one.
+std::string log_problem(const Options& options, const CandumpSource& source, const std::string& problem) {
+  const auto errors = source.errors();
+  return options.replay + ": not a CAN log this profile can use: " + problem +
+         (errors.empty() ? "" : "; first: " + errors.front());
+}
+
+// A file the replay would make nothing of fails here, before any state changes.
+void probe_log(const Options& options, const VehicleProfile& profile) {
+  CandumpSource source(options.replay, kProbeLines);
+  const std::string problem = replay_problem(probe(source, profile, kProbeLines));
+  if (!problem.empty())
+    throw dynid::InputError(log_problem(options, source, problem + " in its first " + std::to_string(kProbeLines) +
+                                                             " lines"));
+}
+
 // Replays options.replay into the pipeline (finished at the end); on_progress as ReplayOptions'.
-ReplayProgress replay_log(const Options& options, CarPipeline& pipe,
-                          std::function<void(const ReplayProgress&)> on_progress) {
+// Returns replay_problem() of the whole log as "<file>: <reason>", or "".
+std::string replay_log(const Options& options, CarPipeline& pipe,
+                       std::function<void(const ReplayProgress&)> on_progress) {
   CandumpSource source(options.replay);
   ReplayOptions ro;
   ro.speed = options.fast ? 0.0 : options.speed;
   ro.progress_interval = 100ms;  // also how often acknowledgements are taken while replaying
   ro.on_progress = std::move(on_progress);
   const ReplayProgress done = replay(source, pipe, ro);
-  spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids), {:.1f} s of log, {} chunks", done.frames,
-               source.bad_input(), done.unknown_id, done.log_seconds, done.chunks);
+  spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids, {} timestamps out of range), {:.1f} s of "
+               "log, {} jumps of its clock, {} chunks",
+               done.frames, source.bad_input(), done.unknown_id, pipe.mapper_stats().bad_time, done.log_seconds,
+               pipe.resampler_stats().pieces_ended, done.chunks);
   for (const auto& e : source.errors()) spdlog::warn("{}", e);
-  return done;
+  const std::string problem = replay_problem(done);
+  return problem.empty() ? problem : log_problem(options, source, problem);
 }
 
-// Reads options.can live into the pipeline until a signal (or options.max_frames frames), then
-// finishes it. `service` runs about every 100 ms (acknowledgements, progress). Both the delivering
-// client and --chunks-out read the bus through this loop.
-void read_bus(const Options& options, CarPipeline& pipe, const std::function<void(const CarPipeline&)>& service) {
-  SocketCanSource source(options.can);
+// Reads the bus (options.can, opened by the caller) live into the pipeline until a signal (or
+// options.max_frames frames), then finishes it. `service` runs about every 100 ms
+// (acknowledgements, progress). Both the delivering client and --chunks-out read the bus
+// through this loop.
+void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe,
+              const std::function<void(const CarPipeline&)>& service) {
   g_live.store(&source);
   struct Unregister {
     ~Unregister() { g_live.store(nullptr); }
@@ -180,6 +212,7 @@ struct Session {
   Delivery& delivery;
   ProgressDisplay& display;
   bool spool_full = false;
+  std::string unusable_log = {};  // of a replayed log judged unusable at its end (replay_log)
   std::string source_name = "resending the spool";
   ReplayProgress last = [] {  // of the source, shown again while draining
     ReplayProgress none;
@@ -203,7 +236,7 @@ struct Session {
   void replay_run(const std::string& run) {
     CarPipeline pipe = pipeline(run);
     source_name = std::filesystem::path(options.replay).filename().string();
-    replay_log(options, pipe, [&](const ReplayProgress& p) {
+    unusable_log = replay_log(options, pipe, [&](const ReplayProgress& p) {
       delivery.service(0ms);
       show(p, p.done);
       if (g_stop.load()) throw Interrupted{};
@@ -213,7 +246,8 @@ struct Session {
   void read_bus_run(const std::string& run) {
     CarPipeline pipe = pipeline(run);
     source_name = "live " + options.can;
-    read_bus(options, pipe, [&](const CarPipeline& p) {
+    SocketCanSource source(options.can);
+    read_bus(options, source, pipe, [&](const CarPipeline& p) {
       delivery.service(0ms);
       ReplayProgress progress;
       progress.frames = p.mapper_stats().frames;
@@ -273,18 +307,23 @@ struct Session {
 // --chunks-out: the same reading and pipeline, the chunks written to a file instead of delivered.
 int write_chunks(const Options& options) {
   const VehicleProfile profile = load_vehicle_profile(options.profile);
+  if (!options.replay.empty()) probe_log(options, profile);
+  // The source is opened before the chunk file is created: a bus that cannot be read leaves none.
+  std::optional<SocketCanSource> live;
+  if (options.replay.empty()) live.emplace(options.can);
   const std::string run = options.run.empty() ? default_run_id() : options.run;
   ChunkFileWriter writer(options.chunks_out);
   CarPipeline pipe(profile, run, [&writer](dynid::ingest::Chunk&& chunk) { writer.write(chunk); });
   spdlog::info("run {}/{}: {} channels at {} Hz, {} rows per chunk, chunks to {}", profile.vehicle, run,
                profile.channels.size(), profile.rate_hz, profile.chunk_rows, options.chunks_out);
+  std::string problem;
   try {
     if (!options.replay.empty()) {
-      replay_log(options, pipe, [](const ReplayProgress&) {
+      problem = replay_log(options, pipe, [](const ReplayProgress&) {
         if (g_stop.load()) throw Interrupted{};
       });
     } else {
-      read_bus(options, pipe, [](const CarPipeline&) {});
+      read_bus(options, *live, pipe, [](const CarPipeline&) {});
     }
   } catch (const Interrupted&) {
     spdlog::warn("interrupted: {} chunks written to {}", writer.chunks(), options.chunks_out);
@@ -292,16 +331,23 @@ int write_chunks(const Options& options) {
   }
   spdlog::info("{} chunks ({} rows, {} invalid) written to {}", writer.chunks(), pipe.resampler_stats().rows,
                pipe.resampler_stats().invalid_rows, options.chunks_out);
+  if (!problem.empty()) {
+    spdlog::error("{}", problem);
+    return kFailed;
+  }
   return g_stop.load() ? kInterrupted : kOk;
 }
 
 int run(const Options& options, ProgressDisplay& display) {
+  // Every input is checked before the spool is touched.
+  const std::string cyclone_config = dynid::dds::config_uri(options.cyclone_config);
   const VehicleProfile profile = load_vehicle_profile(options.profile);
+  if (!options.replay.empty()) probe_log(options, profile);
   const std::filesystem::path spool_dir = options.spool.empty() ? profile.spool_directory : std::filesystem::path(options.spool);
   Spool spool(spool_dir, profile.spool_max_bytes);
   spdlog::info("vehicle {}: spool {} ({} chunks pending)", profile.vehicle, spool.file().string(), spool.count());
 
-  dynid::dds::Participant participant({static_cast<dds_domainid_t>(options.domain), cyclone_uri(options.cyclone_config)});
+  dynid::dds::Participant participant({static_cast<dds_domainid_t>(options.domain), cyclone_config});
   Uplink uplink(participant, profile.vehicle);
   DeliveryOptions delivery_options;
   delivery_options.ack_timeout = std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -325,6 +371,10 @@ int run(const Options& options, ProgressDisplay& display) {
   }
   spdlog::info("all chunks acknowledged: {} stored, {} sent, {} resent in {} rounds, {} rejections", s.submitted,
                s.sent, s.resent, s.resend_rounds, s.rejections);
+  if (!session.unusable_log.empty()) {  // what was good is delivered; the job was not done
+    spdlog::error("{}", session.unusable_log);
+    return kFailed;
+  }
   if (session.spool_full) return kSpoolFull;
   return g_stop.load() ? kInterrupted : kOk;
 }
@@ -334,29 +384,36 @@ int run(const Options& options, ProgressDisplay& display) {
 int main(int argc, char** argv) {
   CLI::App app{"dynid-car: reads the CAN bus or replays a log and delivers the run's chunks to dynid-server"};
   Options o;
-  app.add_option("--profile", o.profile, "vehicle profile (TOML)")->required()->check(CLI::ExistingFile);
-  app.add_option("--run", o.run, "run id (default: run-<UTC time>)");
+  app.add_option("--profile", o.profile, "vehicle profile (TOML)")->required()->check(input::input_file("vehicle profile"));
+  app.add_option("--run", o.run, "run id (default: run-<UTC time>)")->check(input::id("run name"));
   app.add_option("--cyclone-config", o.cyclone_config,
                  "Cyclone DDS configuration: a file (deploy/cyclonedds/*.xml), or file:// URIs and XML "
                  "fragments, comma-separated, as in CYCLONEDDS_URI (required unless --chunks-out)");
   app.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 230));
-  auto* replay_opt = app.add_option("--replay", o.replay, "replay this candump -l log")->check(CLI::ExistingFile);
+  auto* replay_opt = app.add_option("--replay", o.replay, "replay this candump -l log")->check(input::input_file("CAN log"));
   auto* can_opt = app.add_option("--can", o.can, "read this SocketCAN interface live (e.g. can0)");
   replay_opt->excludes(can_opt);
   auto* speed_opt = app.add_option("--speed", o.speed, "replay speed (1 = real time)")
-                        ->check(CLI::PositiveNumber)->needs(replay_opt);
+                        ->check(input::within(kMinSpeed, kMaxSpeed))->needs(replay_opt);
   app.add_flag("--fast", o.fast, "replay as fast as possible")->needs(replay_opt)->excludes(speed_opt);
   app.add_option("--chunks-out", o.chunks_out,
                  "no server: write the run's chunks to this file (length-prefixed "
                  "encode_chunk records) and exit");
   app.add_option("--max-frames", o.max_frames, "live: stop after this many frames")
-      ->check(CLI::PositiveNumber)->needs(can_opt);
+      ->check(input::within(1, kMaxFrames))->needs(can_opt);
   app.add_option("--spool", o.spool, "spool folder (default: the profile's [spool] directory)");
   app.add_option("--drain-timeout", o.drain_timeout, "seconds to wait for the last acknowledgements")
-      ->check(CLI::NonNegativeNumber);
+      ->check(input::within(0.0, kMaxSeconds));
   app.add_option("--ack-timeout", o.ack_timeout, "seconds without acknowledgement before resending")
-      ->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+      ->check(input::within(kMinAckTimeout, kMaxSeconds));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {  // --help
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kFailed;
+  }
   if (!o.chunks_out.empty() && o.replay.empty() && o.can.empty()) {
     std::fprintf(stderr, "dynid-car: --chunks-out needs --replay or --can\n");
     return kFailed;

@@ -7,7 +7,8 @@
 // server, wait until all N shards answered (N comes with the replies) or --timeout, and merge:
 // what the missing shards hold is left out, said on stderr, and the exit code is 6.
 //
-// Exit codes: 0 ok, 2 bad request (or bad command line), 3 not found, 4 the server failed (or
+// Exit codes: 0 ok, 2 bad request (or bad command line: a number outside its limits, a vehicle
+// id or run name that breaks the id rule of dynid/input/ids.hpp), 3 not found, 4 the server failed (or
 // the servers disagree on the shard count), 5 no server answered in time, 6 some shards did
 // not answer (the output holds the others').
 #include <CLI/CLI.hpp>
@@ -15,6 +16,9 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <sstream>
+
+#include <dynid/input/option_checks.hpp>
 
 #include "dynid/cli/request_client.hpp"
 #include "dynid/cli/shard_replies.hpp"
@@ -27,19 +31,17 @@ namespace {
 using namespace std::chrono_literals;
 using dynid::dds::RequestArgument;
 
+// Limits of --timeout and --seconds: beyond a day a duration is a typing error (and past ~9e15
+// it overflows the count of milliseconds).
+constexpr double kMinSeconds = 1e-3;
+constexpr double kMaxSeconds = 86400.0;
+
 struct Common {
   std::string config;
   dds_domainid_t domain = 0;
   double timeout_s = 10.0;
   bool json = false;
 };
-
-// A file path becomes a file:// URI; URIs and XML fragments pass as they are (CYCLONEDDS_URI
-// syntax). There is no default: Cyclone's own would pick the machine's default interface.
-std::string config_uri(const std::string& value) {
-  const bool literal = value.rfind("file://", 0) == 0 || (!value.empty() && value.front() == '<');
-  return literal ? value : dynid::dds::config_file_uri(value);
-}
 
 int exit_code(dynid::dds::ReplyStatus status) {
   switch (status) {
@@ -82,7 +84,7 @@ int request_all(const Common& c, dynid::cli::RequestClient& client, const std::s
 }
 
 int request(const Common& c, const std::string& kind, std::vector<RequestArgument> arguments) {
-  dynid::dds::Participant participant({c.domain, config_uri(c.config)});
+  dynid::dds::Participant participant({c.domain, dynid::dds::config_uri(c.config)});
   dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
   if (kind == "vehicles" || kind == "status") return request_all(c, client, kind);
   if (c.json) arguments.push_back({"format", "json"});
@@ -93,7 +95,7 @@ int request(const Common& c, const std::string& kind, std::vector<RequestArgumen
 int report_request(const Common& c, const std::string& kind, const std::vector<RequestArgument>& arguments,
                    const std::string& html_file) {
   if (html_file.empty()) return request(c, kind, arguments);
-  dynid::dds::Participant participant({c.domain, config_uri(c.config)});
+  dynid::dds::Participant participant({c.domain, dynid::dds::config_uri(c.config)});
   dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
   const dynid::dds::Reply reply = client.call(kind, arguments, timeout_of(c));
   if (reply.status != dynid::dds::ReplyStatus::kOk) return print(kind, reply);
@@ -108,7 +110,7 @@ int report_request(const Common& c, const std::string& kind, const std::vector<R
 }
 
 int watch(const Common& c, const std::string& vehicle, double seconds) {
-  dynid::dds::Participant participant({c.domain, config_uri(c.config)});
+  dynid::dds::Participant participant({c.domain, dynid::dds::config_uri(c.config)});
   dynid::dds::Reader<dynid_wire_Estimate> reader(participant, {dynid::dds::vehicle_partition(vehicle)});
   const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long long>(seconds * 1000));
   std::size_t shown = 0;
@@ -123,6 +125,25 @@ int watch(const Common& c, const std::string& vehicle, double seconds) {
   }
   if (shown == 0) std::cerr << "dynid watch: no estimate of " << vehicle << " in " << seconds << " s\n";
   return shown ? 0 : 5;
+}
+
+// Vehicle ids and run names follow the id rule (dynid/input/ids.hpp) before anything is sent.
+void check_ids(std::initializer_list<std::pair<const char*, std::string>> single, const std::vector<std::string>& runs,
+               const std::string& vehicle_list) {
+  const auto check = [](const std::string& option, const std::string& value) {
+    const bool vehicle = option.find("vehicle") != std::string::npos;
+    try {
+      vehicle ? dynid::input::check_vehicle_id(value) : dynid::input::check_run_name(value);
+    } catch (const dynid::InputError& e) {
+      throw dynid::InputError(option + ": " + e.what());
+    }
+  };
+  for (const auto& [option, value] : single)
+    if (!value.empty()) check(option, value);
+  for (const auto& r : runs) check("--run", r);
+  std::istringstream list(vehicle_list);
+  for (std::string item; std::getline(list, item, ',');)
+    if (!item.empty()) check("--vehicles", item);
 }
 
 std::vector<RequestArgument> args(std::initializer_list<std::pair<const char*, std::string>> list) {
@@ -142,9 +163,10 @@ int main(int argc, char** argv) {
   app.fallthrough();  // --json and the connection options may also follow the subcommand
   app.add_option("--cyclone-config", c.config,
                  "Cyclone DDS configuration: file, file:// URI or XML (or $DYNID_CYCLONE_CONFIG)");
-  app.add_option("--domain", c.domain, "DDS domain id");
+  app.add_option("--domain", c.domain, "DDS domain id")->check(dynid::input::within(0, 230));
   auto* timeout = app.add_option("--timeout", c.timeout_s,
-                                 "seconds to wait for the server (default 10; 120 for residual, add-effect, trace)");
+                                 "seconds to wait for the server (default 10; 120 for residual, add-effect, trace)")
+                      ->check(dynid::input::within(kMinSeconds, kMaxSeconds));
   app.add_flag("--json", c.json, "JSON instead of text");
 
   std::string vehicle, run, model, effects;
@@ -159,7 +181,8 @@ int main(int argc, char** argv) {
   estimates_cmd->add_option("--model", model);
   auto* watch_cmd = app.add_subcommand("watch", "print estimates as they are published");
   watch_cmd->add_option("--vehicle", vehicle)->required();
-  watch_cmd->add_option("--seconds", seconds, "how long to watch")->check(CLI::PositiveNumber);
+  watch_cmd->add_option("--seconds", seconds, "how long to watch")
+      ->check(dynid::input::within(kMinSeconds, kMaxSeconds));
   auto* pooled_cmd = app.add_subcommand("pooled", "estimate over several runs of a vehicle");
   pooled_cmd->add_option("--vehicle", vehicle)->required();
   pooled_cmd->add_option("--run", runs, "runs to pool (repeat)")->required();
@@ -213,7 +236,18 @@ int main(int argc, char** argv) {
   fleet_cmd->add_option("--vehicles", fleet_vehicles,
                      "comma-separated vehicles (closed runs, else the latest), all of one shard")
       ->required();
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+    check_ids({{"--vehicle", vehicle}, {"--run", run}}, runs, fleet_vehicles);
+  } catch (const CLI::Success& e) {  // --help
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  } catch (const dynid::InputError& e) {
+    std::cerr << "dynid: " << e.what() << "\n";
+    return 2;
+  }
   if (c.config.empty()) {
     std::cerr << "dynid: --cyclone-config (or DYNID_CYCLONE_CONFIG) is required, e.g. "
                  "deploy/cyclonedds/loopback.xml\n";

@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <dynid/can/candump.hpp>
 #include <dynid/error.hpp>
+#include <dynid/input/ids.hpp>
+#include <dynid/input/input_file.hpp>
 #include <istream>
 #include <ostream>
 
@@ -36,7 +38,8 @@ std::string_view next_word(std::string_view& s) {
   return w;
 }
 
-std::string quoted(std::string_view s) { return "'" + std::string(s.substr(0, 40)) + "'"; }
+// Escaped: a log's bytes reach messages and log lines (input/ids.hpp printable()).
+std::string quoted(std::string_view s) { return "'" + input::printable(s.substr(0, 40)) + "'"; }
 
 std::string parse_timestamp(std::string_view word, Frame& f) {
   if (word.size() < 3 || word.front() != '(' || word.back() != ')')
@@ -137,6 +140,14 @@ void check_writable(const Frame& f) {
   if (f.fd && f.rtr) throw InputError("candump writer: CAN FD has no remote frames");
 }
 
+// Checked before opening: opening a FIFO would block until a writer appears.
+std::unique_ptr<std::ifstream> open_log(const std::filesystem::path& path) {
+  input::check_input_file(path, "candump log");
+  auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
+  if (!*file) throw InputError(path.string() + ": cannot open the candump log");
+  return file;
+}
+
 }  // namespace
 
 std::string parse_candump_line(std::string_view line, Frame& frame) {
@@ -176,25 +187,40 @@ CandumpReader::CandumpReader(std::istream& in, std::string source, OnError on_er
     : in_(&in), source_(std::move(source)), on_error_(on_error) {}
 
 CandumpReader::CandumpReader(const std::filesystem::path& path, OnError on_error)
-    : file_(std::make_unique<std::ifstream>(path, std::ios::binary)),
-      in_(file_.get()),
-      source_(path.filename().string()),
-      on_error_(on_error) {
-  if (!*file_) throw InputError(path.string() + ": cannot open the candump log");
+    : file_(open_log(path)), in_(file_.get()), source_(path.filename().string()), on_error_(on_error) {}
+
+// getline with a bound: a line is read in pieces of at most kMaxLineBytes, so neither memory nor
+// the time one call takes grows with a line's length. `too_long`: this piece is (part of) a line
+// of kMaxLineBytes or more; `continued`: it is not the start of its line.
+bool CandumpReader::read_line(bool& too_long, bool& continued) {
+  continued = in_long_line_;
+  buffer_.resize(kMaxLineBytes + 1);
+  in_->getline(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+  const auto got = static_cast<std::size_t>(in_->gcount());
+  if (got == 0 && in_->fail()) return false;  // nothing left
+  const bool delimited = !in_->fail() && !in_->eof();  // the '\n' was extracted and counted
+  in_long_line_ = in_->fail() && !in_->eof();       // the buffer filled before a '\n'
+  if (in_long_line_) in_->clear();
+  too_long = continued || in_long_line_;
+  buffer_.resize(delimited ? got - 1 : got);
+  return true;
 }
 
 bool CandumpReader::next(Frame& frame) {
-  while (!stopped_ && std::getline(*in_, buffer_)) {
-    ++line_;
-    if (trim(buffer_).empty()) continue;
-    std::string reason = parse_candump_line(buffer_, frame);
+  bool too_long = false;
+  bool continued = false;
+  while (!stopped_ && read_line(too_long, continued)) {
+    if (!continued) ++line_;
+    if (!too_long && trim(buffer_).empty()) continue;
+    std::string reason = too_long ? "line longer than " + std::to_string(kMaxLineBytes) + " bytes"
+                                  : parse_candump_line(buffer_, frame);
     if (reason.empty()) {
       ++frame_count_;
       return true;
     }
     ++error_count_;
     if (errors_.size() < kMaxKeptErrors) errors_.push_back(LogError{line_, std::move(reason)});
-    stopped_ = on_error_ == OnError::Stop;
+    stopped_ = on_error_ == OnError::Stop || error_count_ >= max_errors_;
   }
   return false;
 }

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <dynid/can/dbc.hpp>
 #include <dynid/error.hpp>
-#include <fstream>
-#include <sstream>
+#include <dynid/input/ids.hpp>
+#include <dynid/input/input_file.hpp>
 #include <unordered_set>
 
 #include "dbc_finalize.hpp"
@@ -51,8 +51,9 @@ class Parser {
   bool at_line_end() const { return peek().opens_line; }
 
   [[noreturn]] void fail(const Token& at, std::string_view reason) const {
-    throw InputError(name_ + ":" + std::to_string(at.line) + ": " + context_ + ": " +
-                     std::string(reason));
+    // Escaped: the file's bytes (names, tokens) reach the message.
+    throw InputError(name_ + ":" + std::to_string(at.line) + ": " +
+                     input::printable_text(context_ + ": " + std::string(reason)));
   }
   [[noreturn]] void fail_expected(std::string_view what) const {
     fail(peek(), "expected " + std::string(what) + ", found " + detail::describe(peek()));
@@ -303,7 +304,7 @@ class Parser {
     return nullptr;
   }
   void warn(const Token& at, const std::string& what) {
-    db_.warnings.push_back(name_ + ":" + std::to_string(at.line) + ": " + context_ + ": " + what);
+    db_.warnings.push_back(name_ + ":" + std::to_string(at.line) + ": " + input::printable_text(context_ + ": " + what));
   }
 
   // Where a CM_ or BA_ applies: the network, a node, a message, a signal or a variable.
@@ -590,12 +591,7 @@ Database parse_dbc_string(std::string_view text, std::string_view name) {
 }
 
 Database parse_dbc_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open the DBC file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(path.string() + ": read error");
-  return parse_dbc_string(text.str(), path.filename().string());
+  return parse_dbc_string(input::read_input_file(path, "DBC file"), path.filename().string());
 }
 
 }  // namespace dynid::can

@@ -6,6 +6,7 @@
 
 #include "byte_codec.hpp"
 #include "dynid/error.hpp"
+#include "dynid/input/ids.hpp"
 
 namespace dynid::ingest {
 namespace {
@@ -41,7 +42,7 @@ detail::ByteWriter encode_body(const Chunk& c) {
 }
 
 std::string name_of(const Chunk& c) {
-  return "chunk " + c.vehicle + "/" + c.run + "#" + std::to_string(c.sequence);
+  return "chunk " + input::printable(c.vehicle) + "/" + input::printable(c.run) + "#" + std::to_string(c.sequence);
 }
 
 [[noreturn]] void reject(const Chunk& c, const std::string& why) {
@@ -94,9 +95,10 @@ std::uint32_t Chunk::compute_checksum() const {
 std::string validate_and_encode(const Chunk& chunk, const RunAnnouncement& run,
                                 const ChunkLimits& limits) {
   if (chunk.vehicle != run.vehicle)
-    reject(chunk, "vehicle '" + chunk.vehicle + "' but the run is of '" + run.vehicle + "'");
+    reject(chunk, "vehicle '" + input::printable(chunk.vehicle) + "' but the run is of '" +
+                      input::printable(run.vehicle) + "'");
   if (chunk.run != run.run)
-    reject(chunk, "run '" + chunk.run + "' but the run is '" + run.run + "'");
+    reject(chunk, "run '" + input::printable(chunk.run) + "' but the run is '" + input::printable(run.run) + "'");
   check_shape(chunk, run, limits);  // first: the encoding below is sized by the shape
   detail::ByteWriter encoded = encode_body(chunk);
   const std::uint32_t expected = detail::crc32_of(encoded.bytes());

@@ -5,6 +5,7 @@
 
 #include "byte_codec.hpp"
 #include "dynid/error.hpp"
+#include "dynid/input/ids.hpp"
 #include "dynid/signal/butterworth.hpp"
 
 namespace dynid::ingest {
@@ -15,7 +16,8 @@ constexpr std::uint16_t kVersion = 1;
 
 [[noreturn]] void reject(const RunAnnouncement& a, const std::string& field,
                          const std::string& why) {
-  throw InputError("run announcement " + a.vehicle + "/" + a.run + ": " + field + " " + why);
+  throw InputError("run announcement " + input::printable(a.vehicle) + "/" + input::printable(a.run) + ": " + field +
+                   " " + why);
 }
 
 void validate_preprocessing(const RunAnnouncement& a) {
@@ -53,8 +55,9 @@ double Preprocessing::cutoff(double sample_rate_hz) const {
 }
 
 void RunAnnouncement::validate() const {
-  if (vehicle.empty()) reject(*this, "vehicle", "is empty");
-  if (run.empty()) reject(*this, "run", "is empty");
+  if (const std::string problem = input::id_problem(vehicle); !problem.empty())
+    reject(*this, "vehicle id", problem);
+  if (const std::string problem = input::id_problem(run); !problem.empty()) reject(*this, "run name", problem);
   if (!(std::isfinite(sample_rate_hz) && sample_rate_hz > 0.0))
     reject(*this, "sample_rate_hz", std::to_string(sample_rate_hz) + " is not positive and finite");
   if (channels.empty()) reject(*this, "channels", "is empty");

@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <string>
 
+#include <dynid/input/ids.hpp>
+
 #include "dynid/dds/conversions.hpp"
 #include "wire_fields.hpp"
 
@@ -51,7 +53,7 @@ std::string chunk_name(const dynid_wire_Chunk& sample) {
   const auto id = [](const dynid_wire_Id& field) {
     return std::string(field, strnlen(field, sizeof field));
   };
-  return "Chunk " + id(sample.vehicle) + "/" + id(sample.run) + "#" +
+  return "Chunk " + input::printable(id(sample.vehicle)) + "/" + input::printable(id(sample.run)) + "#" +
          std::to_string(sample.sequence_number);
 }
 

@@ -1,7 +1,11 @@
 #include "dynid/dds/participant.hpp"
 
+#include <algorithm>
 #include <map>
+#include <string_view>
 #include <mutex>
+
+#include <dynid/input/input_file.hpp>
 
 #include "dynid/dds/error.hpp"
 
@@ -49,7 +53,20 @@ std::string config_file_uri(const std::filesystem::path& file) {
   if (error)
     throw DdsError("config_file_uri: no configuration file " + file.string(),
                    DDS_RETCODE_BAD_PARAMETER);
+  input::check_input_file(absolute, "Cyclone DDS configuration", input::kMaxTextFileBytes);
   return "file://" + absolute.string();
+}
+
+std::string config_uri(const std::string& value) {
+  if (value.rfind("file://", 0) != 0 && value.rfind('<', 0) != 0) return config_file_uri(value);
+  constexpr std::string_view kFile = "file://";
+  for (std::size_t start = 0; start <= value.size();) {
+    const auto comma = std::min(value.find(',', start), value.size());
+    const std::string_view item = std::string_view(value).substr(start, comma - start);
+    if (item.substr(0, kFile.size()) == kFile) config_file_uri(std::string(item.substr(kFile.size())));
+    start = comma + 1;
+  }
+  return value;
 }
 
 Participant::Participant(const ParticipantOptions& options) : domain_id_(options.domain_id) {

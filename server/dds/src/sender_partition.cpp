@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <dynid/input/ids.hpp>
+
 #include <algorithm>
 #include <cstring>
 
@@ -65,8 +67,10 @@ bool SenderPartitionGuard::admits(dds_instance_handle_t publication, const char*
     return true;
   ++refused_;
   if (!w.reported) {
-    spdlog::warn("sample keyed vehicle '{}' refused: its writer {} {}", std::string(vehicle, length),
-                 publication, w.matched ? "wrote in " + joined(w.partitions) + ", not \"" + own + "\""
+    // Escaped: both the key and the partitions come from the network.
+    spdlog::warn("sample keyed vehicle '{}' refused: its writer {} {}", input::printable(std::string(vehicle, length)),
+                 publication, w.matched ? "wrote in " + input::printable(joined(w.partitions)) + ", not \"" +
+                                              input::printable(own) + "\""
                                         : "is no longer matched, its partition cannot be checked");
     w.reported = true;
   }

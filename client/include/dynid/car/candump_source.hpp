@@ -4,7 +4,9 @@
 // Contract: wraps can::CandumpReader in OnError::Continue mode, so a bad line is counted
 // (bad_input(), with the first ones kept in errors()) and skipped, never returned and never
 // fatal. fraction_done() is the share of the file's bytes consumed. Opening a missing or
-// unreadable file throws InputError naming it.
+// unreadable file, or one that is not a regular file (FIFO, directory, device:
+// input/input_file.hpp), throws InputError naming it.
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -19,7 +21,10 @@ namespace dynid::car {
 
 class CandumpSource final : public FrameSource {
  public:
-  explicit CandumpSource(const std::filesystem::path& path);
+  /// max_bad_lines: the source ends at that many bad lines (CandumpReader::stop_after_errors):
+  /// a look at the start of a file that is no log stays bounded.
+  explicit CandumpSource(const std::filesystem::path& path,
+                         std::size_t max_bad_lines = static_cast<std::size_t>(-1));
 
   NextStatus next(can::Frame& frame, std::chrono::milliseconds timeout) override;
   std::uint64_t bad_input() const override { return reader_.error_count(); }

@@ -7,8 +7,9 @@
 // - next() fills `frame` and returns Frame, or returns End once the source is exhausted (a log at
 //   its end, a closed socket: every later call returns End again), or Timeout when no frame came
 //   within `timeout` (live sources; a log never times out). `frame` is unspecified unless Frame.
-// - Frame timestamps are seconds on the source's clock and do not go backwards by more than the
-//   source's own jitter; the consumer (Resampler) drops per-signal samples that go backwards.
+// - Frame timestamps are seconds on the source's clock. They may jump, forwards or backwards, by
+//   any amount: the consumer (Resampler, source_clock.hpp) ends its grid piece at a jump, and
+//   drops per-signal samples that go back less than that.
 // - Input the source itself finds malformed (a bad log line, an error frame) is counted by the
 //   source and never returned; bad_input() reports how many so far.
 // - next() throws only for a failure of the source itself (a read error on the device), never

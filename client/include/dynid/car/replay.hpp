@@ -3,10 +3,13 @@
 // or paced on the log's own clock, reporting progress.
 //
 // Contract:
+// - Log time is the log's clock in pieces (source_clock.hpp, with the pipeline's time_jumps()):
+//   the time the frames cover, a jump of the clock forwards or backwards counting nothing.
 // - speed <= 0: as fast as possible. speed > 0: frame i is fed no earlier than
-//   start + (t_i - t_0) / speed on the steady clock (1 = real time), so 1 s of log takes ~1 s.
-// - max_log_seconds stops after that much log time (from the first frame); the pipeline is
-//   finished either way (final partial chunk emitted).
+//   start + (log time of frame i) / speed on the steady clock (1 = real time), so 1 s of log
+//   takes ~1 s, and a jump of the log's clock, whatever its size, is not waited for.
+// - max_log_seconds stops after that much log time; the pipeline is finished either way (final
+//   partial chunk emitted).
 // - on_progress is called about every progress_interval of wall time and once at the end (with
 //   done = true). Bad lines, unknown ids, short frames and other buses are counted, never sent.
 // - Exceptions from the sink (e.g. the spool is full) propagate: the replay stops there, and the
@@ -15,6 +18,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string>
 
 #include "dynid/car/frame_source.hpp"
 #include "dynid/car/pipeline.hpp"
@@ -23,9 +27,11 @@ namespace dynid::car {
 
 struct ReplayProgress {
   std::uint64_t frames = 0;           ///< good frames read from the source
+  std::uint64_t bad_lines = 0;        ///< input the source found malformed (bad log lines)
   std::uint64_t decoded = 0;          ///< frames the DBC decoded (mapped or not)
+  std::uint64_t mapped = 0;           ///< frames that gave a channel of the profile
   std::uint64_t unknown_id = 0;
-  std::uint64_t bad = 0;              ///< bad lines + short payloads + remote frames + NaN values
+  std::uint64_t bad = 0;  ///< bad lines + short payloads + remote frames + NaN values + bad times
   std::uint64_t other_interface = 0;  ///< frames of buses the profile ignores
   std::uint64_t rows = 0;
   std::uint64_t invalid_rows = 0;
@@ -43,5 +49,15 @@ struct ReplayOptions {
 };
 
 ReplayProgress replay(FrameSource& source, CarPipeline& pipeline, const ReplayOptions& options = {});
+
+/// Why a source with these counts is no log the profile can be identified from, or "" when it
+/// is one: no frame at all, no frame that gives a channel of the profile, or more bad lines than
+/// frames (a file of another format, or corrupted).
+std::string replay_problem(const ReplayProgress& counts);
+
+/// The counts of the source's first `lines` lines (frames + bad input) as a replay with
+/// `profile` would count them, nothing cut or sent: replay_problem() of a probe refuses a file
+/// that is not a usable log before anything of it is announced, spooled or written.
+ReplayProgress probe(FrameSource& source, const VehicleProfile& profile, std::uint64_t lines);
 
 }  // namespace dynid::car

@@ -15,6 +15,9 @@
 //   only on the samples, not on how they were batched. Event-driven (send-on-change) signals do
 //   not fit this rule: give them max_gap.
 //
+// Times are seconds within [0, kMaxTimestamp] (signal_mapper.hpp drops frames outside it), where
+// a double resolves every grid period.
+//
 // Streaming and latency: the clock is the newest timestamp seen (push or advance_clock, which
 // the pipeline calls for every frame, mapped or not). Row k is emitted, in order, as soon as
 // every channel has decided it: it has a sample at or after t_k, or the clock has reached t_k and
@@ -26,6 +29,19 @@
 //
 // Samples of a channel that do not advance its time (duplicate or backwards timestamps) are
 // dropped and counted. Memory per channel is bounded by the samples within the latency window.
+//
+// Time jumps (source_clock.hpp). The source clock of push and advance_clock is cut into pieces
+// by SourceClock with config.jumps: a time more than jumps.forward after the newest one, or more
+// than jumps.backward before it, ends the grid piece. Ending a piece emits what finish() emits
+// (the rows every channel with data has reached), then one invalid row if the last row emitted
+// was valid, so that a consumer's valid segment ends there (the server never filters across
+// it); every channel's history is dropped (as at the start of a run). The next sample starts the
+// new piece: its first row lies at that sample's time. No row is emitted for the time between,
+// so the rows a jump costs are bounded (at most one, plus the rows of a latency window), whatever
+// its size; the grid index counts rows, and across a jump it is no longer (time - origin) x rate.
+// idle(time) is the live loop's clock: once it is more than jumps.forward past the newest
+// sample's or frame's time, the piece ends the same way, and nothing more is emitted until data
+// returns (a bus silent for hours costs at most jumps.forward of invalid rows).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -36,6 +52,8 @@
 #include <span>
 #include <vector>
 
+#include "dynid/car/source_clock.hpp"
+
 namespace dynid::car {
 
 struct ResamplerConfig {
@@ -45,6 +63,7 @@ struct ResamplerConfig {
   std::vector<std::optional<double>> max_gap;  ///< per channel (seconds), or empty
   double max_latency = 1.0;                    ///< seconds of source clock
   std::optional<double> origin;                ///< grid time 0; unset: the first sample's time
+  TimeJumpLimits jumps;                        ///< where the source clock jumps (see above)
 };
 
 struct ResamplerStats {
@@ -53,6 +72,7 @@ struct ResamplerStats {
   std::uint64_t rows = 0;
   std::uint64_t invalid_rows = 0;
   std::vector<std::uint64_t> missing_by_channel;  ///< rows where this channel had no value
+  std::uint64_t pieces_ended = 0;  ///< grid pieces ended by a time jump or a silence
 };
 
 class Resampler {
@@ -64,14 +84,19 @@ class Resampler {
   using RowSink = std::function<void(std::uint64_t, std::span<const double>, bool)>;
 
   /// Throws InputError for a non-positive rate, no channel, max_gap_periods < 1, a
-  /// non-positive max_gap or max_latency, or a max_gap list of the wrong length.
+  /// non-positive max_gap or max_latency, a max_gap list of the wrong length, or jump limits
+  /// that are not positive and finite.
   Resampler(ResamplerConfig config, RowSink sink);
 
   void push(std::size_t channel, double time, double value);
   void advance_clock(double time);
+  /// A live loop's clock without a frame: rows leave within the latency; a silence longer than
+  /// jumps.forward ends the piece (see Time jumps).
+  void idle(double time);
   void finish();
 
-  double origin() const { return origin_.value_or(0.0); }
+  /// Source time of grid index 0 (of the first piece; later pieces start elsewhere).
+  double origin() const { return first_origin_.value_or(0.0); }
   bool started() const { return origin_.has_value(); }
   std::uint64_t next_row() const { return next_row_; }
   const ResamplerStats& stats() const { return stats_; }
@@ -89,6 +114,11 @@ class Resampler {
   };
 
   double row_time(std::uint64_t k) const;
+  void observe(double time);
+  void start_piece(double time);
+  void end_piece();
+  void emit_reached();
+  void deliver(bool valid);
   double judge_interval(std::size_t channel, Channel& c, double interval);
   double stale_after(std::size_t channel, const Channel& c) const;
   bool decided(std::size_t channel, double t) const;
@@ -100,7 +130,11 @@ class Resampler {
   ResamplerConfig config_;
   RowSink sink_;
   std::vector<Channel> channels_;
-  std::optional<double> origin_;
+  std::optional<double> origin_;        // source time of row piece_first_row_; unset between pieces
+  std::optional<double> first_origin_;  // of the first piece
+  std::uint64_t piece_first_row_ = 0;
+  SourceClock source_clock_;
+  bool last_valid_ = false;  // of the last row emitted
   double clock_ = -std::numeric_limits<double>::infinity();
   std::uint64_t next_row_ = 0;
   std::vector<double> row_;

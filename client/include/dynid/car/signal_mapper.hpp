@@ -6,7 +6,10 @@
 // it in stats(): frames from interfaces the profile does not listen to, unknown ids, remote
 // frames and payloads too short for the message are counted and produce no sample; a frame
 // whose channel value is NaN/Inf (a float signal carrying garbage) produces no sample for that
-// channel and is counted as non_finite. The profile must outlive the mapper.
+// channel and is counted as non_finite. A frame whose timestamp is not usable_time() (negative, or
+// past kMaxTimestamp) is counted as bad_time and produces nothing: on such a clock a grid period
+// is below the resolution of a double (at 1e299 s, t + 0.01 == t), so the resampler could not
+// tell one row from the next. The profile must outlive the mapper.
 #include <cstddef>
 #include <cstdint>
 #include <unordered_map>
@@ -24,7 +27,12 @@ struct ChannelSample {
   double value = 0.0;       ///< SI
 };
 
-enum class FrameOutcome { Mapped, Unmapped, OtherInterface, UnknownId, RemoteFrame, ShortPayload };
+enum class FrameOutcome { Mapped, Unmapped, OtherInterface, UnknownId, RemoteFrame, ShortPayload, BadTime };
+
+/// Epoch seconds of the year 2286: a double still resolves 2 us there (a 10 kHz grid's period
+/// is 50 of its steps). Logs with a relative clock (from 0) are within it too.
+inline constexpr double kMaxTimestamp = 1e10;
+inline bool usable_time(double seconds) { return seconds >= 0.0 && seconds <= kMaxTimestamp; }
 
 struct MapStats {
   std::uint64_t frames = 0;
@@ -35,6 +43,7 @@ struct MapStats {
   std::uint64_t remote = 0;
   std::uint64_t short_payload = 0;
   std::uint64_t non_finite = 0;       ///< channel values dropped because NaN/Inf
+  std::uint64_t bad_time = 0;         ///< frames dropped: timestamp not usable_time()
   std::uint64_t decoded() const { return mapped + unmapped; }
 };
 

@@ -11,9 +11,12 @@
 //   dbc = "../../dbc/toyota.dbc"       # relative to this profile file
 //   interfaces = ["can0"]              # optional: frames from other buses are ignored
 //   [grid]
-//   rate_hz = 50.0                     # uniform grid of every run
-//   chunk_seconds = 1.0                # must be a whole number of grid periods
-//   max_gap_periods = 2.5              # optional: see resampler.hpp
+//   rate_hz = 50.0                     # uniform grid of every run, at most 10 kHz
+//   chunk_seconds = 1.0                # a whole number of grid periods, at most 10000 rows
+//   max_gap_periods = 2.5              # optional (1..3600): see resampler.hpp
+//   max_time_jump = 10.0               # optional (seconds, at most 3600): a jump of the frames'
+//                                      # clock, or a bus silence, longer than this ends the
+//                                      # grid piece (source_clock.hpp, resampler.hpp)
 //   [spool]
 //   directory = "spool"                # relative to this profile file unless absolute
 //   max_bytes = 1073741824
@@ -31,15 +34,17 @@
 //   # optional: signal = "X" (one signal), dbc_unit = "bar" (when the DBC has none or a wrong
 //   # one), factor/offset (explicit DBC -> SI conversion instead of the unit table), scale and
 //   # divide_by (a number or the name of a [constants] entry, e.g. "steering_ratio"),
-//   # sign = -1, max_gap (seconds, instead of the derived window).
+//   # sign = -1, max_gap (seconds, at most 3600, instead of the derived window).
 //
 // Value of a channel sample: sign * scale / divide_by * combine_i(conv_i(dbc_value_i)), where
 // conv_i converts signal i from its DBC unit to the channel's SI unit. All signals of a channel
 // come from one message, so they share a timestamp and combining them needs no resampling.
 //
-// Contract: load_vehicle_profile() parses the DBC it names and checks every reference against it.
-// Every error throws InputError "<profile file>:<line>:<column>: <key>: <reason>" (line and
-// column when the key exists), for: TOML syntax, missing keys and wrong types, unknown or
+// Contract: load_vehicle_profile() reads only a regular file (input/input_file.hpp: a FIFO,
+// directory or device is refused naming it), parses the DBC it names (the same) and checks every
+// reference against it. Every error throws InputError "<profile file>:<line>:<column>: <key>:
+// <reason>" (line and column when the key exists), for: a vehicle id that breaks the id rule
+// (input/ids.hpp), TOML syntax, missing keys and wrong types, unknown or
 // duplicate channel, unknown DBC message or signal, a DBC that cannot be read, a missing unit
 // (empty DBC unit for a dimensioned channel and no dbc_unit/factor), an unconvertible unit,
 // a non-finite or non-positive number where one is required, an unknown model or a model whose
@@ -94,6 +99,7 @@ struct VehicleProfile {
   double rate_hz = 0.0;
   std::size_t chunk_rows = 0;
   double max_gap_periods = 2.5;
+  double max_time_jump = 10.0;  ///< seconds (TimeJumpLimits::forward)
   std::vector<ChannelMapping> channels;  ///< the column order of every chunk
   model::Constants constants;
   std::vector<ingest::ModelSpec> models;

@@ -11,7 +11,13 @@
 // Contract: the reader never throws for a bad line. It records the line number and reason,
 // counts it, and by default continues with the next line; with OnError::Stop it stops at the
 // first bad line (next() returns false and stopped() is true). Only the first
-// kMaxKeptErrors errors are kept in errors(); error_count() counts all of them.
+// kMaxKeptErrors errors are kept in errors(); error_count() counts all of them. A line of
+// kMaxLineBytes or more is bad, and counts as one error per kMaxLineBytes of it: it is read in
+// pieces of that size, so a file without newlines (a sparse file, a device's zeros) is read in
+// bounded memory. stop_after_errors(n) stops the reader (as OnError::Stop does) at its n-th
+// error, so that a look at the start of a file (n lines, say) reads at most about
+// n x kMaxLineBytes bytes of it, whatever the file holds. Opening a path that is not a regular file
+// (FIFO, directory, device) throws InputError naming it (input/input_file.hpp).
 #include <cstddef>
 #include <dynid/can/frame.hpp>
 #include <filesystem>
@@ -44,6 +50,8 @@ enum class OnError { Continue, Stop };
 class CandumpReader {
  public:
   static constexpr std::size_t kMaxKeptErrors = 1000;
+  /// Far beyond the longest candump line (a 64-byte FD frame with dots is under 300 bytes).
+  static constexpr std::size_t kMaxLineBytes = 1024;
 
   // Reads from `in`, which must outlive the reader; `source` names it in messages.
   CandumpReader(std::istream& in, std::string source, OnError on_error = OnError::Continue);
@@ -52,6 +60,8 @@ class CandumpReader {
 
   // The next good frame; false at the end of the input or after stopping on an error.
   bool next(Frame& frame);
+  // Stop at the n-th error (counted from the start), whatever on_error says.
+  void stop_after_errors(std::size_t n) { max_errors_ = n; }
 
   const std::vector<LogError>& errors() const { return errors_; }
   std::size_t error_count() const { return error_count_; }
@@ -63,6 +73,8 @@ class CandumpReader {
   std::string describe(const LogError& error) const;
 
  private:
+  bool read_line(bool& too_long, bool& continued);
+
   std::unique_ptr<std::ifstream> file_;
   std::istream* in_;
   std::string source_;
@@ -73,6 +85,8 @@ class CandumpReader {
   std::size_t frame_count_ = 0;
   std::size_t line_ = 0;
   bool stopped_ = false;
+  bool in_long_line_ = false;
+  std::size_t max_errors_ = static_cast<std::size_t>(-1);  // the last piece read filled the buffer before a newline
 };
 
 class CandumpWriter {

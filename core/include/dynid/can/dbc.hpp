@@ -12,6 +12,8 @@
 //   bits, multiplexer cycle, duplicate id) throw dynid::InputError "<name>:<line>: <what>:
 //   <reason>". References to objects the file does not define (CM_/BA_/VAL_ for an unknown
 //   message or signal) are not fatal: they are listed in Database::warnings with file:line.
+// - parse_dbc_file reads only a regular file of at most input::kMaxTextFileBytes (a FIFO, a
+//   directory or a device is refused: input/input_file.hpp).
 // - The returned Database is immutable in use: decoders keep pointers into it.
 #include <cstddef>
 #include <cstdint>

@@ -5,7 +5,9 @@
 // a gap (a signal missing or stale at that grid time: the car-side resampler never interpolates
 // across a gap); the values of an invalid row are ignored but must still be finite (0 is used).
 // Sequence numbers start at 0 and increase by one per chunk of a run; `first_sample_index` is
-// the grid index of row 0 (so time = first_sample_index / sample_rate), which makes chunks
+// the grid index of row 0 (time = first_sample_index / sample_rate from the run's start, except
+// that a jump of the car's clock costs no index: the car ends its grid piece with an invalid row
+// and goes on at the next index, client resampler.hpp "Time jumps"), which makes chunks
 // self-locating and lets the server detect missing or overlapping samples.
 //
 // The checksum is CRC-32 (zlib) over a canonical little-endian encoding of every field but the

@@ -4,8 +4,8 @@
 // models to run with which constants and effects). Transport-neutral: the DDS type in idl/
 // mirrors it and server/client translate at their edge.
 //
-// Contract: validate() throws InputError naming the field and the reason for an empty vehicle or
-// run id, a non-positive or non-finite sample rate, no channel, a duplicate or empty channel
+// Contract: validate() throws InputError naming the field and the reason for a vehicle id or
+// run name that breaks the id rule (input/ids.hpp; the ids are shown escaped), a non-positive or non-finite sample rate, no channel, a duplicate or empty channel
 // name, a model spec without a name, a non-finite constant, preprocessing settings out of range
 // (Butterworth order outside 1..8, a cut-off not strictly inside (0, fs/2), odmf < 1 (also with
 // an explicit cut-off: odmf is the decimation factor of the rows), a filter

@@ -1,21 +1,25 @@
 #pragma once
 // ServerOptions: everything dynid-server is started with, and their command-line form (CLI11).
 //
-//   --store PATH             SQLite store (created if absent)                 required
+//   --store PATH             SQLite store (created if absent; an existing path
+//                            must be a regular file)                          required
 //   --cyclone-config CONFIG  Cyclone configuration: a file path, a file:// URI or an XML
 //                            fragment list as in CYCLONEDDS_URI. Required: the server never
 //                            runs on Cyclone's default configuration (it picks the machine's
 //                            default interface).
-//   --domain D               DDS domain id (0)
-//   --threads T              folding workers (0: one per core)
-//   --checkpoint-every N     save a run's accumulators every N folded chunks (50)
-//   --publish-interval-ms M  publish a run's estimates at most every M ms (250)
+//   --domain D               DDS domain id, 0..230 (0)
+//   --threads T              folding workers, 0..kMaxThreads (0: one per core)
+//   --checkpoint-every N     save a run's accumulators every N folded chunks,
+//                            1..kMaxCheckpointEvery (50)
+//   --publish-interval-ms M  publish a run's estimates at most every M ms,
+//                            0..kMaxPublishIntervalMs (250)
 //   --shard K/N              own the vehicles whose hash mod N == K (0/1: all)
-//   --reorder-window W       chunks stored ahead of a gap (store.hpp) (256)
+//   --reorder-window W       chunks stored ahead of a gap (store.hpp), 1..kMaxReorderWindow (256)
 //   --log-level L            trace, debug, info, warn, error (info)
 //
-// parse_options() throws InputError with CLI11's message on a bad command line, and returns
-// std::nullopt after printing --help.
+// parse_options() throws InputError with CLI11's message on a bad command line (a number
+// outside its limits, NaN or not a number included), and returns std::nullopt after printing
+// --help.
 #include <dds/dds.h>
 
 #include <chrono>
@@ -27,6 +31,13 @@
 #include "dynid/store/store.hpp"
 
 namespace dynid::server {
+
+// Limits of the numeric options: far above any use, below what breaks (threads a process can
+// start, a duration's count).
+inline constexpr unsigned kMaxThreads = 256;
+inline constexpr std::uint64_t kMaxCheckpointEvery = 1000000;
+inline constexpr long long kMaxPublishIntervalMs = 3600000;
+inline constexpr std::uint64_t kMaxReorderWindow = 1000000;
 
 struct ServerOptions {
   std::string store_path;
@@ -43,9 +54,8 @@ struct ServerOptions {
   unsigned worker_count() const;
 };
 
-/// What Participant expects: a value starting with "file://" or "<" is used as it is
-/// (URIs and XML fragments, comma-separated); anything else is a path to a file. Throws
-/// InputError for an empty value and DdsError for a path that does not exist.
+/// What Participant expects (dds::config_uri). Throws InputError for an empty value or a file
+/// that is not a regular file, DdsError for a path that does not exist.
 std::string cyclone_config_uri(const std::string& value);
 
 std::optional<ServerOptions> parse_options(int argc, const char* const* argv);

@@ -21,7 +21,9 @@
 // and candidates are comma-separated lists.
 //
 // parse_request() throws InputError naming the request ("request alice@host/42#7") and the
-// problem: an unknown kind, an unknown, missing, repeated or empty argument, a bad format.
+// problem: an unknown kind, an unknown, missing, repeated or empty argument, a bad format, a
+// vehicle (or an item of vehicles) or run that breaks the id rule (input/ids.hpp). What the
+// message shows of the request (client, kind, argument names, ids) is escaped.
 #include <map>
 #include <optional>
 #include <string>

@@ -33,6 +33,8 @@ class WorkerPool {
   using Task = std::function<void()>;
   using Tick = std::function<void(std::size_t worker)>;
 
+  /// Throws std::runtime_error naming the worker when a thread cannot be started (the ones
+  /// already started are stopped and joined first).
   WorkerPool(std::size_t workers, std::size_t max_queue, std::chrono::milliseconds tick_period,
              Tick tick);
   WorkerPool(const WorkerPool&) = delete;

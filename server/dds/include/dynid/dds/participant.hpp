@@ -28,8 +28,16 @@ struct ParticipantOptions {
   std::string config;  ///< required, see above
 };
 
-/// "file://<absolute path>" for a configuration file (throws DdsError if it does not exist).
+/// "file://<absolute path>" for a configuration file. Throws DdsError if it does not exist,
+/// InputError if it is not a regular file (a FIFO would block Cyclone) or is over
+/// input::kMaxTextFileBytes.
 std::string config_file_uri(const std::filesystem::path& file);
+
+/// The value of a program's --cyclone-config option as Participant takes it: a value starting
+/// with "file://" or "<" (URIs and XML fragments, comma-separated, as in CYCLONEDDS_URI) is used
+/// as it is, after checking every "file://" item as config_file_uri checks a file; anything else
+/// is a path to a file (config_file_uri).
+std::string config_uri(const std::string& value);
 
 class Participant {
  public:

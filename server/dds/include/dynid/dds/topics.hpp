@@ -21,9 +21,9 @@ inline constexpr std::string_view kVehiclePartitionPrefix = "vehicle/";
 /// The wildcard partition covering every vehicle's partition.
 inline constexpr const char* kAllVehiclesPartition = "vehicle/*";
 
-/// "vehicle/<id>". Throws InputError for an empty id, one longer than the wire bound, or one
-/// with a partition wildcard ('*', '?') or backslash: such an id would match, and so expose,
-/// other vehicles' partitions.
+/// "vehicle/<id>". Throws InputError "partition: vehicle id ..." for an id that breaks the id
+/// rule (input/ids.hpp): among others, a partition wildcard ('*', '?') or backslash would match,
+/// and so expose, other vehicles' partitions.
 std::string vehicle_partition(std::string_view vehicle);
 
 template <typename T>
