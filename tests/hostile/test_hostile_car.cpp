@@ -227,6 +227,24 @@ TEST(HostileCar, InputsThatAreNotRegularFilesAreRefusedAtOnce) {
   }
 }
 
+// The chunk file is an output: a FIFO would block the writer until something reads it, a
+// directory cannot hold it. Refused at once, naming it, before the log is read.
+TEST(HostileCar, AChunkFileThatIsNoRegularFileIsRefusedAtOnce) {
+  ScratchDir scratch("hostile-outputs");
+  const auto log = scratch.path() / "can.log";
+  write_log(log, at_epoch(simulated_frames("tare")));
+  for (const auto& [bad, kind] : not_regular_files(scratch)) {
+    if (kind == "character device") continue;  // /dev/null takes the chunks: a user's choice
+    SCOPED_TRACE(kind);
+    const Outcome o = run(Program::Car, {"--profile", testcar_profile().string(), "--replay", log.string(), "--run",
+                                         "r1", "--fast", "--chunks-out", bad.string()},
+                          scratch, 5s);
+    EXPECT_EQ(o.exit, 1) << describe(o);
+    EXPECT_NE(o.output.find(bad.string()), std::string::npos) << describe(o);
+    EXPECT_NE(o.output.find(kind), std::string::npos) << describe(o);
+  }
+}
+
 // A bus that cannot be read (a name no interface can have, one that does not exist, or a kernel
 // without SocketCAN) fails before the chunk file is created.
 TEST(HostileCar, ABusThatCannotBeReadLeavesNoChunkFile) {

@@ -63,5 +63,24 @@ TEST(HostileCli, AConfigurationThatIsNoRegularFileIsRefused) {
   }
 }
 
+// An output that is no regular file (a FIFO would block the writer until something reads it):
+// refused before any request, like an input.
+TEST(HostileCli, AnHtmlReportThatIsNoRegularFileIsRefused) {
+  ScratchDir scratch("hostile-cli-outputs");
+  const auto fifo = scratch.path() / "fifo";
+  make_fifo(fifo);
+  for (const auto& command : std::vector<std::string>{"residual", "add-effect", "trace"})
+    for (const auto& [bad, kind] : std::vector<std::pair<std::string, std::string>>{
+             {fifo.string(), "FIFO"}, {scratch.path().string(), "directory"}}) {
+      SCOPED_TRACE(command + " " + bad);
+      auto args = cli({"--timeout", "1", command, "--vehicle", "v1", "--run", "r1", "--model", "m", "--html", bad});
+      if (command == "add-effect") args.insert(args.end(), {"--effect", "road_grade"});
+      const Outcome o = run(Program::Cli, args, scratch, 5s);
+      EXPECT_EQ(o.exit, 2) << describe(o);
+      EXPECT_NE(o.output.find(kind), std::string::npos) << describe(o);
+      EXPECT_LT(o.seconds, 1.5) << "refused before waiting for a server: " << describe(o);
+    }
+}
+
 }  // namespace
 }  // namespace dynid::hostile

@@ -398,7 +398,8 @@ int main(int argc, char** argv) {
   app.add_flag("--fast", o.fast, "replay as fast as possible")->needs(replay_opt)->excludes(speed_opt);
   app.add_option("--chunks-out", o.chunks_out,
                  "no server: write the run's chunks to this file (length-prefixed "
-                 "encode_chunk records) and exit");
+                 "encode_chunk records) and exit")
+      ->check(input::output_file("chunk file"));
   app.add_option("--max-frames", o.max_frames, "live: stop after this many frames")
       ->check(input::within(1, kMaxFrames))->needs(can_opt);
   app.add_option("--spool", o.spool, "spool folder (default: the profile's [spool] directory)");

@@ -200,14 +200,16 @@ int main(int argc, char** argv) {
   residual_cmd->add_option("--model", model)->required();
   residual_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's)");
   residual_cmd->add_option("--candidates", candidates, "test only these candidates (comma-separated)");
-  residual_cmd->add_option("--html", html, "write the HTML report with plots to this file");
+  residual_cmd->add_option("--html", html, "write the HTML report with plots to this file")
+      ->check(dynid::input::output_file("HTML report"));
   auto* add_effect_cmd = app.add_subcommand("add-effect", "a run's model with one more effect: before and after");
   add_effect_cmd->add_option("--vehicle", vehicle)->required();
   add_effect_cmd->add_option("--run", run)->required();
   add_effect_cmd->add_option("--model", model)->required();
   add_effect_cmd->add_option("--effect", effect, "the effect to add, e.g. road_grade")->required();
   add_effect_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's)");
-  add_effect_cmd->add_option("--html", html, "write the HTML report with plots to this file");
+  add_effect_cmd->add_option("--html", html, "write the HTML report with plots to this file")
+      ->check(dynid::input::output_file("HTML report"));
   add_effect_cmd->add_option("--reference", references, "a known value, name=value (repeat), e.g. mass=1457.5");
   std::string rounds;
   auto* trace_cmd = app.add_subcommand(
@@ -218,7 +220,8 @@ int main(int argc, char** argv) {
   trace_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's; none: no effect)");
   trace_cmd->add_option("--reference", references, "a known value, name=value (repeat), e.g. mass=1457.5");
   trace_cmd->add_option("--rounds", rounds, "effects the loop may add (0 to 10, default 4)");
-  trace_cmd->add_option("--html", html, "write the HTML report with plots to this file");
+  trace_cmd->add_option("--html", html, "write the HTML report with plots to this file")
+      ->check(dynid::input::output_file("HTML report"));
   auto* base_cmd = app.add_subcommand("base", "base-parameter report of a run's model");
   base_cmd->add_option("--vehicle", vehicle)->required();
   base_cmd->add_option("--run", run)->required();

@@ -55,4 +55,18 @@ std::string read_input_file(const std::filesystem::path& path, std::string_view 
   return text;
 }
 
+void check_output_file(const std::filesystem::path& path, std::string_view what) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  const auto type = status.type();
+  // A character device (/dev/null) takes what is written; a FIFO would block, a directory, a
+  // socket or a block device cannot hold the output.
+  if (type == std::filesystem::file_type::not_found || type == std::filesystem::file_type::regular ||
+      type == std::filesystem::file_type::character)
+    return;
+  const std::string where = path.string() + ": " + std::string(what) + ": ";
+  if (ec) throw InputError(where + "cannot examine it: " + ec.message());
+  throw InputError(where + "is " + kind_of(type) + ", not a regular file");
+}
+
 }  // namespace dynid::input

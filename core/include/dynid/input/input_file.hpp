@@ -24,4 +24,10 @@ void check_input_file(const std::filesystem::path& path, std::string_view what, 
 std::string read_input_file(const std::filesystem::path& path, std::string_view what,
                             std::uintmax_t max_bytes = kMaxTextFileBytes);
 
+/// An output the programs write (an HTML report, a chunk file): absent, a regular file (which is
+/// replaced) or a character device such as /dev/null. A FIFO would block the writer until
+/// something reads it; a directory, a socket or a block device cannot hold the output:
+/// InputError "<path>: <what>: is <kind>, not a regular file".
+void check_output_file(const std::filesystem::path& path, std::string_view what);
+
 }  // namespace dynid::input

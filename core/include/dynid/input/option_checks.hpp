@@ -52,6 +52,20 @@ inline CLI::Validator input_file(std::string what) {
       "FILE");
 }
 
+/// A path the program writes: absent or a regular file (check_output_file).
+inline CLI::Validator output_file(std::string what) {
+  return CLI::Validator(
+      [what](std::string& path) -> std::string {
+        try {
+          check_output_file(path, what);
+        } catch (const InputError& e) {
+          return e.what();
+        }
+        return {};
+      },
+      "FILE");
+}
+
 /// A vehicle id (what = "vehicle id") or run name (what = "run name"), as ids.hpp states.
 inline CLI::Validator id(std::string what) {
   return CLI::Validator(
