@@ -1,10 +1,9 @@
 #include "dynid/server/request_parser.hpp"
 
-#include <cmath>
 #include <set>
-#include <stdexcept>
 
 #include <dynid/input/ids.hpp>
+#include <dynid/input/number.hpp>
 
 #include "dynid/error.hpp"
 
@@ -128,32 +127,18 @@ std::map<std::string, double> parse_references(const std::vector<std::string>& a
       throw InputError("reference '" + a + "': expected name=value, e.g. mass=1457.5");
     const std::string name = a.substr(0, equals);
     const std::string text = a.substr(equals + 1);
-    std::size_t used = 0;
-    double value = 0.0;
-    try {
-      value = std::stod(text, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != text.size() || !std::isfinite(value))
-      throw InputError("reference '" + a + "': '" + text + "' is not a finite number");
-    if (!out.emplace(name, value).second) throw InputError("reference '" + name + "' given twice");
+    const std::optional<double> value = input::parse_finite(text);
+    if (!value) throw InputError("reference '" + a + "': '" + text + "' is not a finite number");
+    if (!out.emplace(name, *value).second) throw InputError("reference '" + name + "' given twice");
   }
   return out;
 }
 
 int parse_rounds(const std::optional<std::string>& text) {
   if (!text) return 4;
-  std::size_t used = 0;
-  int rounds = -1;
-  try {
-    rounds = std::stoi(*text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text->size() || rounds < 0 || rounds > 10)
-    throw InputError("rounds '" + *text + "': an integer from 0 to 10");
-  return rounds;
+  const std::optional<long long> rounds = input::parse_integer(*text);
+  if (!rounds || *rounds < 0 || *rounds > 10) throw InputError("rounds '" + *text + "': an integer from 0 to 10");
+  return static_cast<int>(*rounds);
 }
 
 }  // namespace dynid::server

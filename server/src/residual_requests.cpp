@@ -72,7 +72,7 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
   if (request.effect.empty()) {
     residual::DiagnosisOptions options;
     options.screen.only = request.candidates;
-    return diagnosis_reply(residual::diagnose(*model, declared, run, options), title, request.format);
+    return diagnosis_reply(residual::diagnose(*model, declared, run, segments, options), title, request.format);
   }
   const residual::EffectComparison cmp =
       residual::compare_effect(*model, declared, request.effect, segments, rate, odmf, {}, request.reference);

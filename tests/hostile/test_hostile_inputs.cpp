@@ -11,6 +11,7 @@
 #include <dynid/error.hpp>
 #include <dynid/input/ids.hpp>
 #include <dynid/input/input_file.hpp>
+#include <dynid/input/number.hpp>
 
 #include "hostile_support.hpp"
 
@@ -95,6 +96,21 @@ TEST(HostileCandump, LongLinesAreBadInBoundedPiecesAndTheNextLineIsRead) {
   EXPECT_FALSE(reader.next(f));
   EXPECT_TRUE(reader.stopped());
   EXPECT_EQ(reader.error_count(), 10u);
+}
+
+// Numbers in request arguments and effect names: the whole text is the number, finite, or none.
+TEST(HostileNumbers, OnlyAWholeFiniteNumberIsANumber) {
+  EXPECT_EQ(input::parse_finite("1457.5"), 1457.5);
+  EXPECT_EQ(input::parse_finite("-80"), -80.0);
+  EXPECT_EQ(input::parse_finite("1e-3"), 1e-3);
+  EXPECT_EQ(input::parse_finite("1e300"), 1e300);  // finite: the caller bounds it
+  for (const std::string bad : {"nan", "-nan", "inf", "-inf", "abc", "", "0x", "1e", " 1", "1 ", "1.5x", "1e400", "0x10",
+                                "1,5", "+-1"})
+    EXPECT_FALSE(input::parse_finite(bad)) << bad;
+  EXPECT_EQ(input::parse_integer("10"), 10);
+  EXPECT_EQ(input::parse_integer("-3"), -3);
+  for (const std::string bad : {"", "1.0", "3 ", "99999999999999999999999", "nan", "0x1"})
+    EXPECT_FALSE(input::parse_integer(bad)) << bad;
 }
 
 }  // namespace

@@ -285,7 +285,12 @@ std::string Diagnosis::statement() const {
 
 Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
                    const ingest::RecordedRun& run, const DiagnosisOptions& options) {
-  const std::vector<ingest::PreprocessedSegment> segments = ingest::preprocess_offline(run);
+  return diagnose(model, declared, run, ingest::preprocess_offline(run), options);
+}
+
+Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
+                   const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
+                   const DiagnosisOptions& options) {
   if (segments.empty()) throw InputError("residual analysis of " + model.name() + ": the run has no valid segment");
   const double rate = run.announcement.sample_rate_hz;
   const int odmf = run.announcement.preprocessing.odmf;
@@ -293,7 +298,8 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
   d.screen = screen_effects(model, declared, segments, rate, odmf, options.screen);
   NoiseFloorOptions floor_options = options.floor;
   floor_options.fit = options.screen.fit;
-  d.floor = noise_floor(model, declared, run, measure_channel_noise(run, options.declared_noise), floor_options);
+  d.floor = noise_floor(model, declared, run, segments,
+                        measure_channel_noise(run, segments, options.declared_noise), floor_options);
   if (d.floor.adequate()) {
     d.verdict = Verdict::kAdequate;
     return d;

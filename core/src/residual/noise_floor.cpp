@@ -190,12 +190,17 @@ Eigen::Index column_of(const ingest::RunAnnouncement& a, const std::string& chan
 
 std::vector<ChannelNoise> measure_channel_noise(const ingest::RecordedRun& run,
                                                 const std::map<std::string, double>& declared) {
+  return measure_channel_noise(run, ingest::preprocess_offline(run), declared);
+}
+
+std::vector<ChannelNoise> measure_channel_noise(const ingest::RecordedRun& run,
+                                                const std::vector<ingest::PreprocessedSegment>& segments,
+                                                const std::map<std::string, double>& declared) {
   const ingest::RunAnnouncement& a = run.announcement;
   const double rate = a.sample_rate_hz;
   const double cutoff = a.preprocessing.cutoff(rate);
   const double low = kBandLow * cutoff;
   const double high = std::min(kBandHigh * cutoff, 0.9 * rate / 2.0);
-  const std::vector<ingest::PreprocessedSegment> segments = ingest::preprocess_offline(run);
   std::vector<ChannelNoise> out;
   for (std::size_t j = 0; j < a.channels.size(); ++j) {
     const std::string& name = a.channels[j].name;
@@ -229,8 +234,13 @@ bool NoiseFloor::adequate() const {
 NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>& effects,
                        const ingest::RecordedRun& run, const std::vector<ChannelNoise>& noise,
                        const NoiseFloorOptions& options) {
+  return noise_floor(model, effects, run, ingest::preprocess_offline(run), noise, options);
+}
+
+NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>& effects,
+                       const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
+                       const std::vector<ChannelNoise>& noise, const NoiseFloorOptions& options) {
   if (options.draws < 1) throw InputError("noise floor: draws " + std::to_string(options.draws) + " < 1");
-  const std::vector<ingest::PreprocessedSegment> segments = ingest::preprocess_offline(run);
   if (segments.empty()) throw InputError("noise floor of " + model.name() + ": the run has no valid segment");
   const double rate = run.announcement.sample_rate_hz;
   const int odmf = run.announcement.preprocessing.odmf;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "dynid/error.hpp"
+#include "dynid/input/number.hpp"
 
 namespace dynid::residual {
 namespace {
@@ -46,22 +47,17 @@ model::ChannelSet delayed_set(const model::ChannelSet& set, const std::vector<Si
 bool is_delay_effect(const std::string& name) { return name.rfind(kPrefix, 0) == 0; }
 
 SignalDelay parse_delay_effect(const std::string& name, double sample_rate_hz) {
+  const std::string form = "effect '" + name + "': expected delay:<channel>@<milliseconds>ms";
+  if (!is_delay_effect(name)) throw InputError(form);
   const std::string rest = name.substr(std::string(kPrefix).size());
   const auto at = rest.rfind('@');
-  if (!is_delay_effect(name) || at == std::string::npos || at == 0 || rest.size() < at + 4 ||
-      rest.compare(rest.size() - 2, 2, "ms") != 0)
-    throw InputError("effect '" + name + "': expected delay:<channel>@<milliseconds>ms");
+  if (at == std::string::npos || at == 0 || rest.size() < at + 4 || rest.compare(rest.size() - 2, 2, "ms") != 0)
+    throw InputError(form);
   const std::string number = rest.substr(at + 1, rest.size() - at - 3);
-  std::size_t used = 0;
-  double ms = 0.0;
-  try {
-    ms = std::stod(number, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != number.size() || !std::isfinite(ms) || std::abs(ms) > 10000.0)
+  const std::optional<double> ms = input::parse_finite(number);
+  if (!ms || std::abs(*ms) > 10000.0)
     throw InputError("effect '" + name + "': '" + number + "' is not a delay in milliseconds (|d| <= 10 s)");
-  return {rest.substr(0, at), static_cast<Eigen::Index>(std::llround(ms * sample_rate_hz / 1000.0))};
+  return {rest.substr(0, at), static_cast<Eigen::Index>(std::llround(*ms * sample_rate_hz / 1000.0))};
 }
 
 std::string delay_effect_name(const std::string& channel, Eigen::Index samples, double sample_rate_hz) {

@@ -46,7 +46,7 @@ Trace trace(const model::Model& model, const std::vector<std::string>& declared,
   t.declared = declared;
   std::vector<std::string> effects = declared;
   for (int round = 0;; ++round) {
-    TraceRound r{effects, diagnose(model, effects, run, options.diagnosis), std::nullopt};
+    TraceRound r{effects, diagnose(model, effects, run, segments, options.diagnosis), std::nullopt};
     const Verdict verdict = r.diagnosis.verdict;
     if (verdict != Verdict::kExplained) {
       t.stopped = std::string(verdict_name(verdict)) + " after " + std::to_string(round) + " added effect" +

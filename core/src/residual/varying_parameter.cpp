@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "dynid/error.hpp"
+#include "dynid/input/number.hpp"
 
 namespace dynid::residual {
 namespace {
@@ -46,14 +47,9 @@ VaryingParameter parse_varying_effect(const std::string& name, const model::Mode
   v.parameter = rest.substr(0, at);
   v.column = column_of(model, v.parameter, name);
   const std::string time = rest.substr(at + 1, rest.size() - at - 2);
-  std::size_t used = 0;
-  try {
-    v.step_time_s = std::stod(time, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != time.size() || !std::isfinite(v.step_time_s))
-    throw InputError("effect '" + name + "': '" + time + "' is not a time in seconds");
+  const std::optional<double> t0 = input::parse_finite(time);
+  if (!t0) throw InputError("effect '" + name + "': '" + time + "' is not a time in seconds");
+  v.step_time_s = *t0;
   return v;
 }
 

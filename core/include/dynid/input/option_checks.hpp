@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "dynid/error.hpp"
 #include "dynid/input/ids.hpp"
@@ -38,32 +39,29 @@ inline CLI::Validator within(double min, double max) {
       "NUMBER in " + range);
 }
 
-/// A path the program reads: a regular file (check_input_file).
-inline CLI::Validator input_file(std::string what) {
+/// A validator from a check that throws InputError: the error's text, or nothing.
+template <typename Check>
+CLI::Validator from_check(Check check, std::string description) {
   return CLI::Validator(
-      [what](std::string& path) -> std::string {
+      [check](std::string& text) -> std::string {
         try {
-          check_input_file(path, what);
+          check(text);
         } catch (const InputError& e) {
           return e.what();
         }
         return {};
       },
-      "FILE");
+      std::move(description));
 }
 
-/// A path the program writes: absent or a regular file (check_output_file).
+/// A path the program reads: a regular file (check_input_file).
+inline CLI::Validator input_file(std::string what) {
+  return from_check([what](const std::string& path) { check_input_file(path, what); }, "FILE");
+}
+
+/// A path the program writes: absent, a regular file or a character device (check_output_file).
 inline CLI::Validator output_file(std::string what) {
-  return CLI::Validator(
-      [what](std::string& path) -> std::string {
-        try {
-          check_output_file(path, what);
-        } catch (const InputError& e) {
-          return e.what();
-        }
-        return {};
-      },
-      "FILE");
+  return from_check([what](const std::string& path) { check_output_file(path, what); }, "FILE");
 }
 
 /// A vehicle id (what = "vehicle id") or run name (what = "run name"), as ids.hpp states.

@@ -87,5 +87,10 @@ struct Diagnosis {
 /// floor needs the raw samples). InputError as screen_effects.
 Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
                    const ingest::RecordedRun& run, const DiagnosisOptions& options = {});
+/// The same with `segments` = preprocess_offline(run), for a caller that has them already (the
+/// trace diagnoses one run round after round).
+Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
+                   const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
+                   const DiagnosisOptions& options);
 
 }  // namespace dynid::residual

@@ -62,6 +62,10 @@ struct ChannelNoise {
 /// cut-off (no segment of 256 samples) are reported with sigma 0 and source "not measured".
 std::vector<ChannelNoise> measure_channel_noise(const ingest::RecordedRun& run,
                                                 const std::map<std::string, double>& declared = {});
+/// The same with `segments` = preprocess_offline(run), for a caller that has them already.
+std::vector<ChannelNoise> measure_channel_noise(const ingest::RecordedRun& run,
+                                                const std::vector<ingest::PreprocessedSegment>& segments,
+                                                const std::map<std::string, double>& declared);
 
 struct GroupFloor {
   std::string group;
@@ -98,5 +102,9 @@ struct NoiseFloor {
 NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>& effects,
                        const ingest::RecordedRun& run, const std::vector<ChannelNoise>& noise,
                        const NoiseFloorOptions& options = {});
+/// The same with `segments` = preprocess_offline(run), for a caller that has them already.
+NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>& effects,
+                       const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
+                       const std::vector<ChannelNoise>& noise, const NoiseFloorOptions& options);
 
 }  // namespace dynid::residual
