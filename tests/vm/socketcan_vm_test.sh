@@ -199,6 +199,10 @@ write_init() {
     echo "CAR_RUN=$CAR_RUN CAR_GRACE=$CAR_GRACE"
     cat <<'INIT'
 /bin/busybox --install -s /bin
+# The firmware's "Booting from ROM.." ends without a newline on the serial console: end that line
+# first, or the first marker is glued to it and its anchored grep misses it (seen once in CI:
+# "Booting from ROM..DYNID-DUMP-STATUS 0").
+echo
 export PATH=/bin:/opt/bin LD_LIBRARY_PATH=/lib/x86_64-linux-gnu:/usr/lib/x86_64-linux-gnu
 vmfail() { echo "DYNID-VM-FAIL $*"; poweroff -f; }
 # Waits until the dump whose stderr goes to $1 has bound its socket.
