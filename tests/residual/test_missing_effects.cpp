@@ -195,5 +195,41 @@ TEST(MissingEffect, StribeckInTheClutchModel) { expect_found_and_fixed(stribeck(
 TEST(MissingEffect, RoadBankInTheLateralKinematicModel) { expect_found_and_fixed(road_bank(), 64); }
 TEST(MissingEffect, BrakeDragInTheLongitudinalModel) { expect_found_and_fixed(brake_drag(), 65); }
 
+// A head wind on a coast-down: the aerodynamic force becomes 0.5 rho SCx (v + w)^2, i.e. SCx's
+// own column plus a speed-proportional term (linear_drag's) plus a constant (rolling
+// resistance's). On one run in one direction the speed-proportional term is nearly a
+// combination of v^2 and 1: the loop either finds it (explained by linear_drag) or must say
+// that it cannot be separated, with a bias at least as large as what the wind did to SCx.
+TEST(MissingEffect, AHeadWindIsFoundOrReportedAsInseparableWithTheBiasItCauses) {
+  const Case c{"head wind, acceleration", "acceleration.toml", "\n[vehicle]\nhead_wind = 8.0\n", "longitudinal_wheel",
+               {}, {}, true, {"linear_drag"}, {{"SCx", "vehicle.scx"}}};
+  const sim::Run run = sim::test::run(scenario_text(c), 66);
+  const ingest::ModelSpec spec = sim::test::model_spec(c.model, c.declared, c.constants);
+  const test::ProcessedRun processed = test::process(run, spec, c.tare);
+  const auto model = model::make_model(spec.model, spec.constants);
+  const Diagnosis d = diagnose(*model, c.declared, processed.recorded);
+  std::printf("%s\n", d.statement().c_str());
+  for (const Inseparable& i : d.inseparable) std::printf("%s\n", i.statement().c_str());
+  if (d.accepted && d.accepted->effect == "linear_drag") return;
+  const auto wind = std::find_if(d.inseparable.begin(), d.inseparable.end(),
+                                 [](const Inseparable& i) { return i.effect == "linear_drag"; });
+  ASSERT_NE(wind, d.inseparable.end()) << "the wind's term is neither found nor said to be inseparable";
+  EXPECT_TRUE(wind->identifiable);
+  EXPECT_NE(wind->separated_by.find("both directions"), std::string::npos) << wind->separated_by;
+  // What the wind did to SCx is within what the report says the run cannot rule out.
+  const std::vector<model::ParameterInfo> parameters = model->parameters_with(c.declared);
+  const auto scx = static_cast<Eigen::Index>(
+      std::find_if(parameters.begin(), parameters.end(), [](const model::ParameterInfo& p) { return p.name == "SCx"; }) -
+      parameters.begin());
+  const double error = d.screen.fit.estimate.value(scx) - sim::test::truth_value(run, "vehicle.scx");
+  const double std_scx = d.screen.fit.estimate.standard_deviation(scx);
+  std::printf("SCx error %.4g m^2 (std %.2g)\n", error, std_scx);
+  EXPECT_GT(std::abs(error), 2.0 * std_scx) << "the wind did not bias SCx: the case tests nothing";
+  ASSERT_EQ(wind->parameter.empty(), false);
+  if (wind->parameter == "SCx") {
+    EXPECT_GE(std::abs(wind->shift), std::abs(error) - 2.0 * std_scx);
+  }
+}
+
 }  // namespace
 }  // namespace dynid::residual

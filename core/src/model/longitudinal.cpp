@@ -109,7 +109,11 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
           {effect::kLinearDrag,
            "resistance proportional to speed (tyre losses)",
            {non_negative(parameter("linear_drag", "N s/m", "speed-proportional resistance"))},
-           {}},
+           {},
+           // A head wind w adds rho SCx w v (this column) and a constant (rolling resistance's):
+           // runs in opposite directions change its sign, tyre losses keep theirs (SAE J2263).
+           "coast-downs in both directions of one road, from high speed down (a wind changes sign "
+           "with the direction, tyre losses do not)"},
           [](const ChannelSet& set) { return detail::channel(set, "vx"); }),
       detail::brake_drag("brake_force_gain", "N/Pa")};
   if (source_ != Source::kEngineTorque) return out;

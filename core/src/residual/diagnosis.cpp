@@ -296,6 +296,7 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
   const int odmf = run.announcement.preprocessing.odmf;
   Diagnosis d;
   d.screen = screen_effects(model, declared, segments, rate, odmf, options.screen);
+  d.inseparable = inseparable_effects(model, d.screen);
   NoiseFloorOptions floor_options = options.floor;
   floor_options.fit = options.screen.fit;
   d.floor = noise_floor(model, declared, run, segments,

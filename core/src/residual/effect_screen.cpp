@@ -6,6 +6,8 @@
 #include <limits>
 #include <utility>
 
+#include <boost/math/distributions/normal.hpp>
+
 #include "dynid/error.hpp"
 #include "dynid/model/effects.hpp"
 #include "dynid/residual/road_profile.hpp"
@@ -19,6 +21,8 @@ namespace {
 
 // Relative drops closer than this are ties (the same column under two names).
 constexpr double kTie = 1e-6;
+// The power at which CandidateScore::detectable is stated (the usual design figure).
+constexpr double kPower = 0.8;
 
 struct Candidate {
   std::string effect;
@@ -137,6 +141,10 @@ CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, const s
   if (s.columns == 1) {
     s.coefficient = after.all.value(rows.last_effect_first);
     s.coefficient_std = wald.first_std;
+    s.coefficient_unit = rows.parameters[static_cast<std::size_t>(rows.last_effect_first)].unit;
+    const Eigen::VectorXd alias =
+        detail::regress_column(rows, rows.last_effect_first, base_columns, after.estimator_weights);
+    s.alias.assign(alias.data(), alias.data() + alias.size());
   }
   return s;
 }
@@ -235,8 +243,13 @@ void decide(ScreenResult& result, double family_error_rate) {
   result.tests = static_cast<int>(std::count_if(result.candidates.begin(), result.candidates.end(),
                                                 [](const CandidateScore& c) { return c.evaluated; }));
   result.level = result.tests > 0 ? family_error_rate / result.tests : 0.0;
-  for (CandidateScore& c : result.candidates)
+  const double power_z = boost::math::quantile(boost::math::normal(), kPower);
+  for (CandidateScore& c : result.candidates) {
     c.significant = c.evaluated && c.testable && c.p_value < result.level && c.held_out_drop > 0.0;
+    if (c.testable && c.columns == 1)
+      c.detectable = (boost::math::quantile(boost::math::normal(), 1.0 - result.level / 2.0) + power_z) *
+                     c.coefficient_std;
+  }
 }
 
 // Significant first; significant physics before the rest; then by the held-out drop, the

@@ -5,6 +5,8 @@
 #include <limits>
 #include <memory>
 
+#include <Eigen/QR>
+
 #include "dynid/error.hpp"
 #include "dynid/residual/road_profile.hpp"
 #include "dynid/residual/signal_delay.hpp"
@@ -265,6 +267,26 @@ FoldedRows with_extra_column(const FoldedRows& base, const std::vector<std::vect
   buffers.fold_into(out.folds, width + 1);
   if (out.rows() == 0) throw InputError("residual analysis: no row left for '" + info.name + "'");
   return out;
+}
+
+Eigen::VectorXd regress_column(const FoldedRows& rows, Eigen::Index column, const std::vector<Eigen::Index>& on,
+                               const std::vector<double>& weights) {
+  const auto stride = static_cast<Eigen::Index>(rows.parameters.size()) + 1;
+  Eigen::Index total = 0;
+  for (const std::vector<double>& v : rows.collected.values) total += static_cast<Eigen::Index>(v.size()) / stride;
+  Eigen::MatrixXd a(total, static_cast<Eigen::Index>(on.size()));
+  Eigen::VectorXd c(total);
+  Eigen::Index i = 0;
+  for (std::size_t g = 0; g < rows.collected.values.size(); ++g) {
+    const std::vector<double>& v = rows.collected.values[g];
+    const double w = g < weights.size() ? weights[g] : 1.0;
+    for (std::size_t at = 0; at < v.size(); at += static_cast<std::size_t>(stride), ++i) {
+      for (std::size_t j = 0; j < on.size(); ++j)
+        a(i, static_cast<Eigen::Index>(j)) = w * v[at + static_cast<std::size_t>(on[j])];
+      c(i) = w * v[at + static_cast<std::size_t>(column)];
+    }
+  }
+  return a.colPivHouseholderQr().solve(c);
 }
 
 Eigen::VectorXd base_solution(const ls::Estimate& estimate) {

@@ -91,4 +91,10 @@ FoldedRows with_extra_column(const FoldedRows& base, const std::vector<std::vect
 /// The solution with NaN (not identifiable) entries set to 0: the base-parameter solution.
 Eigen::VectorXd base_solution(const ls::Estimate& estimate);
 
+/// The weighted least-squares regression of collected column `column` on the collected columns
+/// `on`, each group's rows weighted by `weights` (per group of rows.groups): the coefficients b
+/// of the omitted-variable identity, x_without = x_with + b * coefficient (effect_screen.hpp).
+Eigen::VectorXd regress_column(const FoldedRows& rows, Eigen::Index column, const std::vector<Eigen::Index>& on,
+                               const std::vector<double>& weights);
+
 }  // namespace dynid::residual::detail

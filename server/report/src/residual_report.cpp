@@ -100,6 +100,7 @@ std::string format_diagnosis_text(const residual::Diagnosis& d, std::size_t top)
   if (!noise.empty()) out += "noise of the channels the rows read: " + noise + "\n";
   out += format_screen_text(d.screen, top);
   for (const residual::RefusedCandidate& r : d.refused) out += "refused: " + r.effect + ": " + r.reason + "\n";
+  for (const residual::Inseparable& i : d.inseparable) out += i.statement() + "\n";
   for (const residual::CorrelationFinding& f : d.signature.correlations)
     out += fmt::format("residual of {} correlates with {} at lag {:+.0f} ms: r = {:.2f} (bound {:.2f})\n", f.group,
                        f.channel, 1000.0 * f.lag_s, f.correlation, f.bound);
@@ -114,6 +115,7 @@ std::string format_trace_text(const residual::Trace& t) {
     out += fmt::format("\n== round {} (effects: {}) ==\n{}\n", i + 1,
                        r.effects.empty() ? "none" : fmt::format("{}", fmt::join(r.effects, ", ")),
                        r.diagnosis.statement());
+    for (const residual::Inseparable& ins : r.diagnosis.inseparable) out += ins.statement() + "\n";
     if (r.added) out += format_comparison_text(*r.added);
   }
   const std::vector<std::string> added = t.added();
@@ -142,7 +144,11 @@ json candidate_json(const residual::CandidateScore& c) {
           {"p_value", finite(c.p_value)},
           {"testable", c.testable},
           {"significant", c.significant},
-          {"finding", c.finding}};
+          {"finding", c.finding},
+          {"coefficient", finite(c.coefficient)},
+          {"coefficient_std", finite(c.coefficient_std)},
+          {"coefficient_unit", c.coefficient_unit},
+          {"detectable", finite(c.detectable)}};
 }
 
 json diagnosis_object(const residual::Diagnosis& d) {
@@ -163,6 +169,18 @@ json diagnosis_object(const residual::Diagnosis& d) {
   for (const residual::CandidateScore& c : d.screen.candidates) candidates.push_back(candidate_json(c));
   json refused = json::array();
   for (const residual::RefusedCandidate& r : d.refused) refused.push_back({{"effect", r.effect}, {"reason", r.reason}});
+  json inseparable = json::array();
+  for (const residual::Inseparable& i : d.inseparable)
+    inseparable.push_back({{"effect", i.effect},
+                           {"identifiable", i.identifiable},
+                           {"detectable", finite(i.detectable)},
+                           {"unit", i.unit},
+                           {"parameter", i.parameter},
+                           {"shift", finite(i.shift)},
+                           {"shift_relative", finite(i.shift_relative)},
+                           {"shift_in_std", finite(i.shift_in_std)},
+                           {"separated_by", i.separated_by},
+                           {"statement", i.statement()}});
   json correlations = json::array();
   for (const residual::CorrelationFinding& f : d.signature.correlations)
     correlations.push_back({{"group", f.group},
@@ -179,6 +197,7 @@ json diagnosis_object(const residual::Diagnosis& d) {
           {"candidate_level", finite(d.screen.level)},
           {"candidates", candidates},
           {"refused", refused},
+          {"inseparable", inseparable},
           {"signature",
            {{"correlations", correlations},
             {"span_group", d.signature.span_group},

@@ -169,7 +169,8 @@ void body_and_planar(const VehicleParameters& v, const Effects& fx, const State&
   const double gy = e.gravity[1];
   const double gz = e.gravity[2];
   const double vx = s[kVx];
-  e.aero_drag = fx.aero_drag ? 0.5 * v.air_density * v.scx * vx * std::abs(vx) : 0.0;
+  const double air_speed = vx + v.head_wind;
+  e.aero_drag = fx.aero_drag ? 0.5 * v.air_density * v.scx * air_speed * std::abs(air_speed) : 0.0;
 
   double sum_fx = 0.0, sum_fy = 0.0, yaw_moment = 0.0;
   double heave = 0.0, roll = 0.0, pitch = 0.0;
@@ -250,7 +251,7 @@ double CarModel::road_load_force(double speed) const {
   const auto& v = car.vehicle;
   double f = 0.0;
   if (effects.rolling_resistance) f += v.rolling_resistance * v.mass * kGravity;
-  if (effects.aero_drag) f += 0.5 * v.air_density * v.scx * speed * speed;
+  if (effects.aero_drag) f += 0.5 * v.air_density * v.scx * (speed + v.head_wind) * std::abs(speed + v.head_wind);
   if (effects.brake_drag) f += 4.0 * v.brake_drag_torque / v.wheel_radius;
   return f;
 }

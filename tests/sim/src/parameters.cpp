@@ -40,6 +40,7 @@ std::vector<std::pair<std::string, double*>> named_parameters(CarParameters& car
       {"vehicle.track_rear", &v.track_rear},
       {"vehicle.cg_height", &v.cg_height},
       {"vehicle.aero_height", &v.aero_height},
+      {"vehicle.head_wind", &v.head_wind},
       {"vehicle.wheel_radius", &v.wheel_radius},
       {"vehicle.wheel_inertia", &v.wheel_inertia},
       {"vehicle.cornering_stiffness_front", &v.cornering_stiffness_front},

@@ -61,6 +61,9 @@ struct Effect {
   std::string description;  ///< the physics, one line
   std::vector<ParameterInfo> parameters;  ///< the extra columns it adds
   std::vector<std::string> channels;      ///< channels it needs beyond the model's own
+  /// The manoeuvre that tells this effect apart from the model's parameters, where the physics
+  /// says so (residual/separability.hpp); empty: none stated.
+  std::string separated_by = "";
 };
 
 /// How far from its own sample a row reads, in samples: the row at k depends on samples

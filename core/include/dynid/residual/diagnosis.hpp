@@ -35,6 +35,7 @@
 #include "dynid/model/model.hpp"
 #include "dynid/residual/effect_screen.hpp"
 #include "dynid/residual/noise_floor.hpp"
+#include "dynid/residual/separability.hpp"
 
 namespace dynid::residual {
 
@@ -78,6 +79,11 @@ struct Diagnosis {
   std::optional<CandidateScore> accepted;
   std::vector<RefusedCandidate> refused;  ///< significant candidates refused, with the reason
   Signature signature;
+  /// Physical effects this run cannot rule out although they would bias the declared
+  /// parameters beyond their std (separability.hpp), whatever the verdict: an effect that only
+  /// rescales the fit (a head wind against drag and rolling resistance) leaves the residual at
+  /// the floor.
+  std::vector<Inseparable> inseparable;
   Verdict verdict = Verdict::kAdequate;
   /// One paragraph: the verdict and its evidence.
   std::string statement() const;

@@ -100,6 +100,17 @@ struct CandidateScore {
   /// late"); empty for the others.
   std::string finding;
   bool significant = false;
+  /// Single-column candidates: how much each declared parameter (in the declared fit's order)
+  /// moves per unit of the candidate's coefficient when the candidate is left out: the
+  /// omitted-variable identity x_without = x_with + alias * coefficient, alias the weighted
+  /// regression of the candidate's column on the declared columns over the tested rows.
+  std::vector<double> alias;
+  /// The smallest coefficient this test would find with 80 % power at the screen's level:
+  /// (z_{1-level/2} + z_{0.8}) * coefficient_std. A true effect below it can pass unseen and
+  /// still move the declared parameters by alias * detectable (diagnosis.hpp: "cannot be
+  /// separated on this run").
+  double detectable = 0.0;
+  std::string coefficient_unit;  ///< of coefficient, detectable
 };
 
 struct ScreenOptions {

@@ -58,6 +58,7 @@ struct VehicleParameters {
   // Resistances.
   double scx = 0.62;                  // drag area S Cx, m^2 (assumed)
   double air_density = 1.225;         // kg/m^3
+  double head_wind = 0.0;             // m/s of air against the car (an effect no model declares)
   double rolling_resistance = 0.011;  // coefficient f_r (force = f_r Fz per tyre)
   double brake_drag_torque = 4.0;     // residual pad drag per wheel, N m (assumed)
   double brake_gain_front = 2.0e-4;   // brake torque per wheel per master-cylinder Pa, N m/Pa
