@@ -29,6 +29,7 @@ const std::map<std::string, KindSpec>& kinds() {
       {"residual", {{"vehicle", "run", "model"}, {"effects", "candidates", "format"}, {}}},
       {"add-effect", {{"vehicle", "run", "model", "effect"}, {"effects", "reference", "format"}, {"reference"}}},
       {"trace", {{"vehicle", "run", "model"}, {"effects", "reference", "rounds", "format"}, {"reference"}}},
+      {"consistency", {{"vehicle", "run"}, {"reference", "format"}, {"reference"}}},
       {"status", {{}, {"format"}, {}}},
       {"fleet", {{"model", "shared", "vehicles"}, {"format"}, {"shared"}}},
   };

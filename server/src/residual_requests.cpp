@@ -6,6 +6,7 @@
 #include "dynid/report/residual_html.hpp"
 #include "dynid/report/residual_report.hpp"
 #include "dynid/residual/effect_comparison.hpp"
+#include "dynid/residual/consistency.hpp"
 #include "dynid/residual/diagnosis.hpp"
 #include "dynid/residual/effect_screen.hpp"
 #include "dynid/residual/trace.hpp"
@@ -45,6 +46,26 @@ ResidualReply trace_reply(const residual::Trace& t, const std::string& title, co
   return {report::format_trace_text(t), "text/plain"};
 }
 
+// Every announced model with its declared effects; a model the run cannot fit (no row: a
+// manoeuvre that never meets its masks) is left out and named.
+ResidualReply consistency_reply(const ingest::RunAnnouncement& announcement, const std::vector<ingest::PreprocessedSegment>& segments,
+                                const ResidualRequest& request) {
+  std::vector<residual::ModelParameters> fits;
+  std::vector<std::string> left_out;
+  for (const ingest::ModelSpec& spec : announcement.models) {
+    try {
+      const auto model = model::make_model(spec.model, spec.constants);
+      fits.push_back(residual::hac_parameters(*model, spec.effects, segments, announcement.sample_rate_hz,
+                                              announcement.preprocessing.odmf));
+    } catch (const InputError& e) {
+      left_out.push_back(spec.model + ": " + e.what());
+    }
+  }
+  const residual::Consistency c = residual::check_consistency(fits, request.reference);
+  if (request.format == "json") return {report::consistency_json(c, left_out), "application/json"};
+  return {report::format_consistency_text(c, left_out), "text/plain"};
+}
+
 }  // namespace
 
 ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
@@ -53,13 +74,16 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
     throw InputError("residual report: format '" + request.format + "' (text, json or html)");
   if (request.rounds < 0 || request.rounds > 10)
     throw InputError("trace: rounds " + std::to_string(request.rounds) + " (0 to 10)");
-  const ingest::ModelSpec& spec = announced_model(announcement, request.model);
-  const std::vector<std::string> declared = request.effects.value_or(spec.effects);
-  const auto model = model::make_model(spec.model, spec.constants);
+  if (request.kind == "consistency" && request.format == "html")
+    throw InputError("consistency report: format 'html' (text or json)");
   const ingest::RecordedRun run = ingest::assemble_run(announcement, chunks);
   const auto segments = ingest::preprocess_offline(run);
   if (segments.empty())
     throw InputError("run " + announcement.vehicle + "/" + announcement.run + ": no valid segment long enough to filter");
+  if (request.kind == "consistency") return consistency_reply(announcement, segments, request);
+  const ingest::ModelSpec& spec = announced_model(announcement, request.model);
+  const std::vector<std::string> declared = request.effects.value_or(spec.effects);
+  const auto model = model::make_model(spec.model, spec.constants);
   const double rate = announcement.sample_rate_hz;
   const int odmf = announcement.preprocessing.odmf;
   const std::string title = announcement.vehicle + " / " + announcement.run + " / " + spec.model;

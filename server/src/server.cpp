@@ -163,8 +163,8 @@ dds::Reply Server::Impl::execute(const ParsedRequest& r, RunService& service) {
                      r.json());
   } else if (r.kind == "base") {
     payload = service.base_report(vehicle, r.required("run"), r.required("model"), r.json());
-  } else if (r.kind == "residual" || r.kind == "add-effect" || r.kind == "trace") {
-    ResidualRequest request{r.required("model"), std::nullopt, split_list(r.optional("candidates").value_or("")),
+  } else if (r.kind == "residual" || r.kind == "add-effect" || r.kind == "trace" || r.kind == "consistency") {
+    ResidualRequest request{r.kind == "consistency" ? "" : r.required("model"), std::nullopt, split_list(r.optional("candidates").value_or("")),
                             r.kind == "add-effect" ? r.required("effect") : "", r.optional("format").value_or("text"),
                             r.kind, parse_references(r.all("reference")), parse_rounds(r.optional("rounds"))};
     if (const auto effects = r.optional("effects"))  // "none": the model with no effect declared

@@ -108,6 +108,19 @@ TEST(E2eResidualCli, DiagnosesAndTracesInTextAndJson) {
   const auto rounds = dynid(args);
   EXPECT_EQ(rounds.exit_code, 2);
   EXPECT_NE(rounds.err.find("0 to 10"), std::string::npos) << rounds.err;
+
+  // Every model of the run, shared parameters and a reference value compared.
+  args = {"consistency", "--vehicle", "trace-car", "--run", "run-t", "--reference", "sensor_scale=1.0"};
+  const auto consistency = dynid(args);
+  ASSERT_EQ(consistency.exit_code, 0) << consistency.err;
+  EXPECT_NE(consistency.out.find("consistency: "), std::string::npos) << consistency.out;
+  EXPECT_NE(consistency.out.find("sensor_scale"), std::string::npos) << consistency.out;
+  args.push_back("--json");
+  const auto consistency_json = dynid(args);
+  ASSERT_EQ(consistency_json.exit_code, 0) << consistency_json.err;
+  const auto c = nlohmann::json::parse(consistency_json.out);
+  EXPECT_FALSE(c.at("comparisons").empty());
+  EXPECT_EQ(c.at("comparisons").front().at("against"), "reference");
 }
 
 }  // namespace

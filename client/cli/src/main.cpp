@@ -222,6 +222,11 @@ int main(int argc, char** argv) {
   trace_cmd->add_option("--rounds", rounds, "effects the loop may add (0 to 10, default 4)");
   trace_cmd->add_option("--html", html, "write the HTML report with plots to this file")
       ->check(dynid::input::output_file("HTML report"));
+  auto* consistency_cmd = app.add_subcommand(
+      "consistency", "do a run's models agree with each other and with known values? (docs/RESIDUAL.md)");
+  consistency_cmd->add_option("--vehicle", vehicle)->required();
+  consistency_cmd->add_option("--run", run)->required();
+  consistency_cmd->add_option("--reference", references, "a known value, name=value (repeat), e.g. mass=1457.5");
   auto* base_cmd = app.add_subcommand("base", "base-parameter report of a run's model");
   base_cmd->add_option("--vehicle", vehicle)->required();
   base_cmd->add_option("--run", run)->required();
@@ -278,6 +283,12 @@ int main(int argc, char** argv) {
                      {"format", html.empty() ? "" : "html"}});
       for (const auto& r : references) a.push_back({"reference", r});
       return report_request(c, *residual_cmd ? "residual" : (*add_effect_cmd ? "add-effect" : "trace"), a, html);
+    }
+    if (*consistency_cmd) {
+      if (timeout->count() == 0) c.timeout_s = 120.0;  // every model of the run fitted
+      auto a = args({{"vehicle", vehicle}, {"run", run}});
+      for (const auto& r : references) a.push_back({"reference", r});
+      return request(c, "consistency", a);
     }
     if (*base_cmd) return request(c, "base", args({{"vehicle", vehicle}, {"run", run}, {"model", model}}));
     if (*close_cmd) return request(c, "close", args({{"vehicle", vehicle}, {"run", run}}));

@@ -173,6 +173,9 @@ WaldTest hac_wald_test(const FoldedRows& rows, const Eigen::VectorXd& x, const s
     for (Eigen::Index c = 0; c < q; ++c)
       v(a, c) = covariance(tested[static_cast<std::size_t>(a)], tested[static_cast<std::size_t>(c)]);
   }
+  result.stds = Eigen::VectorXd::Constant(end - first, std::numeric_limits<double>::quiet_NaN());
+  for (Eigen::Index a = 0; a < q; ++a)
+    result.stds(used[static_cast<std::size_t>(tested[static_cast<std::size_t>(a)])] - first) = std::sqrt(std::max(0.0, v(a, a)));
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(v);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || (ldlt.vectorD().array() <= 0.0).any()) return result;
   result.statistic = b.dot(ldlt.solve(b));

@@ -27,6 +27,8 @@ struct WaldTest {
   double p_value = 1.0;
   int bandwidth = 0;      ///< Newey-West lags, in decimated rows
   double first_std = 0.0; ///< HAC standard deviation of the first tested coefficient
+  /// HAC standard deviation of every tested column, in column order (NaN: not identifiable).
+  Eigen::VectorXd stds;
 };
 
 /// Tests columns [first, end) of `rows` (collected: fold_rows with collect) at the weighted

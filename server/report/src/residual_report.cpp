@@ -107,6 +107,22 @@ std::string format_diagnosis_text(const residual::Diagnosis& d, std::size_t top)
   return out + "diagnosis: " + d.statement() + "\n";
 }
 
+std::string format_consistency_text(const residual::Consistency& c, const std::vector<std::string>& left_out) {
+  std::string out;
+  if (!c.comparisons.empty())
+    out += fmt::format("{:<22} {:<22} {:>14} {:>10} {:<22} {:>14} {:>10} {:>7}\n", "parameter", "model", "value", "std",
+                       "against", "value", "std", "z");
+  for (const residual::ParameterAgreement& a : c.comparisons)
+    out += fmt::format("{:<22} {:<22} {:>14} {:>10} {:<22} {:>14} {:>10} {:>+7.2f}{}\n", a.parameter + " [" + a.unit + "]",
+                       a.first, number(a.first_value), number(a.first_std), a.second, number(a.second_value),
+                       a.second == residual::kReference ? "-" : number(a.second_std), a.z, a.significant ? " *" : "");
+  if (!c.comparisons.empty())
+    out += fmt::format("(* beyond the level {:.2g}: family error rate 1 % over {} comparisons; std are HAC)\n", c.level,
+                       c.tests);
+  for (const std::string& l : left_out) out += "left out: " + l + "\n";
+  return out + "consistency: " + c.statement() + "\n";
+}
+
 std::string format_trace_text(const residual::Trace& t) {
   std::string out = fmt::format("trace of {} (declared effects: {})\n", t.model,
                                 t.declared.empty() ? "none" : fmt::format("{}", fmt::join(t.declared, ", ")));
@@ -243,6 +259,40 @@ json comparison_object(const residual::EffectComparison& c) {
 
 std::string diagnosis_json(const residual::Diagnosis& d) { return diagnosis_object(d).dump(); }
 std::string comparison_json(const residual::EffectComparison& c) { return comparison_object(c).dump(); }
+
+std::string consistency_json(const residual::Consistency& c, const std::vector<std::string>& left_out) {
+  json comparisons = json::array();
+  for (const residual::ParameterAgreement& a : c.comparisons)
+    comparisons.push_back({{"parameter", a.parameter},
+                           {"unit", a.unit},
+                           {"model", a.first},
+                           {"value", finite(a.first_value)},
+                           {"std", finite(a.first_std)},
+                           {"against", a.second},
+                           {"against_value", finite(a.second_value)},
+                           {"against_std", finite(a.second_std)},
+                           {"z", finite(a.z)},
+                           {"p_value", finite(a.p_value)},
+                           {"significant", a.significant}});
+  json scales = json::array();
+  for (const residual::ScaleFinding& f : c.scales)
+    scales.push_back({{"model", f.first},
+                      {"against", f.second},
+                      {"parameters", f.parameters},
+                      {"ratio", finite(f.ratio)},
+                      {"ratio_std", finite(f.ratio_std)},
+                      {"homogeneity_p", finite(f.homogeneity_p)},
+                      {"one_ratio", f.one_ratio},
+                      {"off", f.off},
+                      {"statement", f.statement}});
+  return json{{"consistent", c.consistent()},
+              {"level", finite(c.level)},
+              {"comparisons", comparisons},
+              {"scales", scales},
+              {"left_out", left_out},
+              {"statement", c.statement()}}
+      .dump();
+}
 
 std::string trace_json(const residual::Trace& t) {
   json rounds = json::array();

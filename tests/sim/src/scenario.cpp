@@ -7,6 +7,7 @@
 #include <toml++/toml.h>
 
 #include "dynid/error.hpp"
+#include "dynid/sim/channels.hpp"
 
 namespace dynid::sim {
 namespace {
@@ -199,8 +200,21 @@ Scenario parse_scenario(std::string_view text, std::string_view source_name) {
         else if (rk.str() == "bank") s.road.bank = r.profile(rn, key);
         else r.fail(key, "unknown key (grade, bank)");
       }
+    } else if (name == "sensor_gain") {
+      for (const auto& [ck, cn] : t) {
+        const std::string channel(ck.str());
+        const std::string key = "sensor_gain." + channel;
+        try {
+          channel_index(channel);
+        } catch (const InputError& e) {
+          r.fail(key, e.what());
+        }
+        const double gain = r.number(cn, key);
+        if (!(gain > 0.0)) r.fail(key, "must be > 0");
+        s.sensor_gains[channel] = gain;
+      }
     } else {
-      r.fail(name, "unknown table (run, manoeuvre, effects, road, vehicle, driveline)");
+      r.fail(name, "unknown table (run, manoeuvre, effects, road, vehicle, driveline, sensor_gain)");
     }
   }
   check(r, s);

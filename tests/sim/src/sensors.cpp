@@ -47,9 +47,12 @@ SensorSpec default_sensor(std::string_view c) {
   return {};
 }
 
-SensorBank::SensorBank(std::uint64_t seed, const Effects& effects, double noise_scale)
+SensorBank::SensorBank(std::uint64_t seed, const Effects& effects, double noise_scale,
+                       const std::map<std::string, double>& gains)
     : noise_(effects.sensor_noise), noise_scale_(noise_scale) {
   for (const auto& c : channel_catalogue()) {
+    const auto gain = gains.find(c.name);
+    gains_.push_back(gain == gains.end() ? 1.0 : gain->second);
     specs_.push_back(default_sensor(c.name));
     streams_.emplace_back(fnv1a(c.name, seed));
     // The offset comes from its own stream, so the noise sequence does not depend on it.
@@ -60,7 +63,7 @@ SensorBank::SensorBank(std::uint64_t seed, const Effects& effects, double noise_
 
 double SensorBank::measure(std::size_t channel, double true_value) {
   const SensorSpec& spec = specs_[channel];
-  double value = true_value + offsets_[channel];
+  double value = gains_[channel] * true_value + offsets_[channel];
   if (noise_ && spec.noise > 0.0) value += noise_scale_ * spec.noise * normal(streams_[channel]);
   return value;
 }

@@ -92,7 +92,7 @@ class Recorder {
  public:
   Recorder(const Scenario& sc, std::uint64_t seed, const can::Database& dbc)
       : bus_(dbc, can_bindings(sc.car.vehicle)),
-        sensors_(seed, sc.effects, sc.noise_scale),
+        sensors_(seed, sc.effects, sc.noise_scale, sc.sensor_gains),
         quantize_(sc.effects.quantization),
         iface_(sc.interface_name),
         t0_(sc.start_timestamp),

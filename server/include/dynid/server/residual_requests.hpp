@@ -6,6 +6,11 @@
 //   add-effect  vehicle*, run*, model*, effect*, effects, format      before/after report
 //   trace       vehicle*, run*, model*, effects, reference, rounds,    the loop: diagnose, add,
 //               format                                                diagnose again (trace.hpp)
+//   consistency vehicle*, run*, reference, format                      every announced model
+//                                                                     fitted with its effects;
+//                                                                     shared parameters and
+//                                                                     references compared
+//                                                                     (consistency.hpp)
 //
 // `effects` (comma list) are the model's declared effects; absent, those the run's announcement
 // gives the model; "none", no effect. `candidates` (comma list) restricts the screen. `reference` (repeatable,
@@ -33,8 +38,8 @@ struct ResidualRequest {
   std::vector<std::string> candidates;              ///< empty: every candidate
   std::string effect;                               ///< add-effect only
   std::string format = "text";                      ///< text | json | html
-  std::string kind = "residual";                    ///< residual | add-effect | trace
-  std::map<std::string, double> reference;          ///< trace only
+  std::string kind = "residual";                    ///< residual | add-effect | trace | consistency
+  std::map<std::string, double> reference;          ///< add-effect, trace, consistency
   int rounds = 4;                                   ///< trace only
 };
 

@@ -5,7 +5,9 @@
 // (--json), and as one self-contained HTML page with plots (residual_html.hpp).
 #include <cstddef>
 #include <string>
+#include <vector>
 
+#include "dynid/residual/consistency.hpp"
 #include "dynid/residual/diagnosis.hpp"
 #include "dynid/residual/effect_comparison.hpp"
 #include "dynid/residual/effect_screen.hpp"
@@ -31,9 +33,15 @@ std::string format_diagnosis_text(const residual::Diagnosis& diagnosis, std::siz
 /// table) and why it stopped.
 std::string format_trace_text(const residual::Trace& trace);
 
+/// The consistency check of a run's models (dynid consistency): every comparison (parameter,
+/// the two sides with their HAC std, z, significant), the scale findings, the statement, and the
+/// models left out with the reason.
+std::string format_consistency_text(const residual::Consistency& consistency, const std::vector<std::string>& left_out);
+
 /// The same as JSON objects, for tools (nlohmann::json; NaN and infinities as null).
 std::string diagnosis_json(const residual::Diagnosis& diagnosis);
 std::string comparison_json(const residual::EffectComparison& comparison);
 std::string trace_json(const residual::Trace& trace);
+std::string consistency_json(const residual::Consistency& consistency, const std::vector<std::string>& left_out);
 
 }  // namespace dynid::report

@@ -11,10 +11,13 @@
 //   [effects]    the Effects switches by name (effects.hpp), true/false
 //   [road]       grade = [[distance_m, rad], ...], bank = [[distance_m, rad], ...]
 //   [vehicle] / [driveline]   any parameter of parameters.hpp by its field name
+//   [sensor_gain] <channel> = gain: that sensor reads gain x the truth (a calibration error that
+//                only a second model or a reference value can reveal)
 // Contract: unknown tables or keys, wrong types and out-of-range values throw InputError naming
 // the file, the key and the reason (a typo must not silently run the default).
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <string_view>
 
@@ -32,6 +35,7 @@ struct Scenario {
   double start_timestamp = 1700000000.0;
   std::string interface_name = "can0";
   double noise_scale = 1.0;
+  std::map<std::string, double> sensor_gains;  // channel -> gain, 1 when absent
   CarParameters car = default_parameters();
   Effects effects;
   Road road;

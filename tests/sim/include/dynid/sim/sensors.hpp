@@ -8,7 +8,9 @@
 // run (N(0, offset_sigma)) and reported in the truth file. Channels whose spec is all zero
 // (gear, gear_ratio, the driver's commands known exactly) pass through unchanged.
 #include <cstdint>
+#include <map>
 #include <random>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -26,8 +28,10 @@ SensorSpec default_sensor(std::string_view channel);
 
 class SensorBank {
  public:
-  // `noise_scale` multiplies every noise level (not the offsets).
-  SensorBank(std::uint64_t seed, const Effects& effects, double noise_scale);
+  // `noise_scale` multiplies every noise level (not the offsets); `gains` (channel -> gain) scales
+  // a sensor's reading of the truth.
+  SensorBank(std::uint64_t seed, const Effects& effects, double noise_scale,
+             const std::map<std::string, double>& gains = {});
   double measure(std::size_t channel, double true_value);
   const std::vector<double>& offsets() const { return offsets_; }
 
@@ -35,6 +39,7 @@ class SensorBank {
   std::vector<SensorSpec> specs_;
   std::vector<std::mt19937_64> streams_;
   std::vector<double> offsets_;
+  std::vector<double> gains_;
   bool noise_ = true;
   double noise_scale_ = 1.0;
 };

@@ -1,0 +1,90 @@
+#pragma once
+// Consistency: what two models of one run, or a model and a known value, say about the same
+// parameter (issue 15: "some missing effects leave no trace in any residual: a torque signal that
+// reads 7 % high, or a rolling radius 3 % off, rescale every parameter of a model exactly and the
+// residual only scales. They show up as disagreement").
+//
+// Compared: every parameter that two models of the run share by name (the wheel-torque and the
+// engine-torque longitudinal models share mass, SCx, rolling resistance; the clutch and the
+// locked-driveline models share the engine inertia), and every parameter for which the engineer
+// gives a reference value (the weighed mass). The test of one comparison: z = (a - b) /
+// sqrt(sa^2 + sb^2) (a reference has no std), two-sided, at family_error_rate / m (Bonferroni over
+// the m comparisons, so that a run whose models agree raises an alarm at most that often).
+// Ignoring the correlation of two fits of one run is conservative: they share the run's noise,
+// which makes var(a - b) smaller than sa^2 + sb^2, not larger.
+//
+// The standard deviations are HAC ones (Newey-West on the rows' scores, hac_wald.hpp): the rows
+// are low-passed and decimated, and DYCARO's sigma^2 (W'W)^-1 counts every row as independent,
+// which would call a 1 % difference of two honest fits significant.
+//
+// Traced to a scale: when models disagree and every parameter they share disagrees by one
+// common ratio (the log-ratios' homogeneity chi-square test does not reject at the same level),
+// the disagreement has the signature of a scale error of one model's measured side (its torque
+// sensor, or the rolling radius or gear ratio its force is computed with): a finding like any
+// other, with the ratio and its std. A reference value, when given, says which side is off.
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "dynid/ingest/recorded_run.hpp"
+#include "dynid/model/model.hpp"
+#include "dynid/residual/model_fit.hpp"
+
+namespace dynid::residual {
+
+/// One model's estimate on a run, with HAC standard deviations.
+struct ModelParameters {
+  std::string model;
+  std::vector<std::string> measured_side;  ///< Model::measured_side()
+  std::vector<model::ParameterInfo> parameters;
+  Eigen::VectorXd value;  ///< NaN: not identifiable
+  Eigen::VectorXd std;    ///< HAC; NaN where the value is
+};
+
+/// `model` with `effects` fitted on `run` (preprocessed segments), with HAC standard deviations.
+/// InputError as fit_model.
+ModelParameters hac_parameters(const model::Model& model, const std::vector<std::string>& effects,
+                               const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
+                               int odmf, const FitOptions& options = {});
+
+inline constexpr const char* kReference = "reference";
+
+struct ParameterAgreement {
+  std::string parameter;
+  std::string unit;
+  std::string first;   ///< a model
+  std::string second;  ///< another model, or kReference
+  double first_value = 0.0, first_std = 0.0;
+  double second_value = 0.0, second_std = 0.0;  ///< a reference's std is 0
+  double z = 0.0;
+  double p_value = 1.0;
+  bool significant = false;
+};
+
+struct ScaleFinding {
+  std::string first, second;  ///< models (second may be kReference)
+  std::vector<std::string> parameters;  ///< the shared parameters the ratio rests on
+  double ratio = 1.0;      ///< first's parameters over second's
+  double ratio_std = 0.0;
+  double homogeneity_p = 1.0;  ///< one common ratio for all of them (1 with one parameter)
+  bool one_ratio = true;       ///< homogeneity not rejected
+  std::string off;             ///< the model a reference shows to be off, empty when unknown
+  std::string statement;
+};
+
+struct Consistency {
+  std::vector<ParameterAgreement> comparisons;
+  int tests = 0;
+  double level = 0.0;  ///< family_error_rate / tests
+  std::vector<ScaleFinding> scales;  ///< one per pair with a significant disagreement
+  bool consistent() const;
+  /// One paragraph.
+  std::string statement() const;
+};
+
+Consistency check_consistency(const std::vector<ModelParameters>& models,
+                              const std::map<std::string, double>& reference, double family_error_rate = 0.01);
+
+}  // namespace dynid::residual

@@ -1,0 +1,114 @@
+// Consistency across models and with known values (residual/consistency.hpp): shared parameters
+// compared within their HAC std, a disagreement traced to one common scale, a reference value
+// saying which side is off; then on simulated runs through the product's data path, a wheel
+// torque meter that reads 7 % high, which leaves no trace in the residual.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "dynid/model/registry.hpp"
+#include "dynid/residual/consistency.hpp"
+#include "dynid/residual/diagnosis.hpp"
+#include "residual_test_support.hpp"
+#include "sim_product_path.hpp"
+#include "sim_test_support.hpp"
+
+namespace dynid::residual {
+namespace {
+
+ModelParameters fitted(const std::string& model, std::vector<std::string> measured_side,
+                       const std::vector<std::pair<std::string, double>>& values, double relative_std) {
+  ModelParameters m;
+  m.model = model;
+  m.measured_side = std::move(measured_side);
+  m.value.resize(static_cast<Eigen::Index>(values.size()));
+  m.std.resize(m.value.size());
+  for (std::size_t j = 0; j < values.size(); ++j) {
+    m.parameters.push_back({values[j].first, "u", "", std::nullopt});
+    m.value(static_cast<Eigen::Index>(j)) = values[j].second;
+    m.std(static_cast<Eigen::Index>(j)) = relative_std * std::abs(values[j].second);
+  }
+  return m;
+}
+
+const std::vector<std::pair<std::string, double>> kTruth{{"mass", 1500.0}, {"SCx", 0.62}, {"rolling_resistance", 220.0}};
+
+std::vector<std::pair<std::string, double>> scaled(double s) {
+  std::vector<std::pair<std::string, double>> out = kTruth;
+  for (auto& [name, value] : out) value *= s;
+  return out;
+}
+
+TEST(Consistency, ModelsThatAgreeWithinTheirStdAreConsistent) {
+  const Consistency c = check_consistency({fitted("wheel", {"wheel_torque"}, scaled(1.004), 0.005),
+                                           fitted("engine", {"engine_torque"}, scaled(0.997), 0.006)},
+                                          {{"mass", 1500.0}});
+  EXPECT_TRUE(c.consistent()) << c.statement();
+  EXPECT_EQ(c.tests, 5);  // three shared parameters, mass against the reference twice
+  EXPECT_TRUE(c.scales.empty());
+}
+
+TEST(Consistency, OneCommonRatioIsTracedToTheScaleOfTheSideTheReferenceShowsOff) {
+  const Consistency c = check_consistency({fitted("wheel", {"wheel_torque"}, scaled(1.07), 0.004),
+                                           fitted("engine", {"engine_torque"}, scaled(1.0), 0.004)},
+                                          {{"mass", 1500.0}});
+  ASSERT_FALSE(c.consistent());
+  ASSERT_FALSE(c.scales.empty());
+  const ScaleFinding& f = c.scales.front();
+  EXPECT_EQ(f.first, "wheel");
+  EXPECT_EQ(f.second, "engine");
+  EXPECT_TRUE(f.one_ratio);
+  EXPECT_NEAR(f.ratio, 1.07, 1e-9);
+  EXPECT_EQ(f.off, "wheel");
+  EXPECT_NE(f.statement.find("wheel_torque reads +7.0 %"), std::string::npos) << f.statement;
+}
+
+TEST(Consistency, DisagreementsByDifferentRatiosAreNotCalledAScale) {
+  std::vector<std::pair<std::string, double>> other = kTruth;
+  other[1].second *= 1.3;  // SCx off alone: an effect, not a scale
+  const Consistency c = check_consistency({fitted("wheel", {"wheel_torque"}, kTruth, 0.004),
+                                           fitted("engine", {"engine_torque"}, other, 0.004)},
+                                          {});
+  ASSERT_EQ(c.scales.size(), 1U);
+  EXPECT_FALSE(c.scales.front().one_ratio) << c.scales.front().statement;
+}
+
+// The product's path: the acceleration run's longitudinal model against the simulated car's
+// equivalent mass given as a reference value, with the wheel torque meter right and 7 % high.
+struct SimulatedCheck {
+  Consistency consistency;
+  Diagnosis diagnosis;
+};
+
+SimulatedCheck check_with_gain(double gain, std::uint64_t seed) {
+  const std::string text = sim::test::load_scenario_text("acceleration.toml") +
+                           "\n[sensor_gain]\nwheel_torque = " + std::to_string(gain) + "\n";
+  const sim::Run run = sim::test::run(text, seed);
+  const ingest::ModelSpec spec = sim::test::model_spec("longitudinal_wheel", {});
+  const test::ProcessedRun processed = test::process(run, spec, true);
+  const auto model = model::make_model(spec.model, spec.constants);
+  const ModelParameters fit = hac_parameters(*model, {}, processed.segments, processed.announcement.sample_rate_hz,
+                                             processed.announcement.preprocessing.odmf);
+  const double mass = sim::test::truth_value(run, "vehicle.longitudinal_equivalent_mass");
+  SimulatedCheck out{check_consistency({fit}, {{"mass", mass}}), diagnose(*model, {}, processed.recorded)};
+  std::printf("wheel torque gain %.2f: %s\n  residual: %s\n", gain, out.consistency.statement().c_str(),
+              out.diagnosis.statement().c_str());
+  return out;
+}
+
+TEST(Consistency, AWheelTorqueMeterReadingHighIsFoundAgainstTheWeighedMassNotInTheResidual) {
+  const SimulatedCheck right = check_with_gain(1.0, 71);
+  EXPECT_TRUE(right.consistency.consistent()) << right.consistency.statement();
+  const SimulatedCheck high = check_with_gain(1.07, 71);
+  ASSERT_FALSE(high.consistency.consistent());
+  const ScaleFinding& f = high.consistency.scales.front();
+  EXPECT_EQ(f.second, kReference);
+  EXPECT_NEAR(f.ratio, 1.07, 3.0 * f.ratio_std + 0.01) << f.statement;
+  EXPECT_NE(f.statement.find("wheel_torque"), std::string::npos) << f.statement;
+  // The residual alone cannot tell: the fit rescales and the verdict does not change.
+  EXPECT_EQ(high.diagnosis.verdict, right.diagnosis.verdict);
+}
+
+}  // namespace
+}  // namespace dynid::residual
