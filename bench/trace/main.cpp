@@ -118,7 +118,7 @@ std::string json_run(const RunResult& r) {
   std::ostringstream o;
   o << "{\"family\":\"" << json_escape(r.family) << "\",\"seed\":" << r.seed << ",\"drawn\":\"" << json_escape(r.drawn)
     << "\",\"outcome\":\"" << outcome_name(r.outcome) << "\",\"seconds\":" << r.seconds << ",\"error\":\""
-    << json_escape(r.error) << "\"";
+    << json_escape(r.error) << "\",\"right_added_later\":" << (r.right_later ? "true" : "false");
   if (r.cross_checked)
     o << ",\"harness_cross_model_check\":{\"flagged\":" << (r.cross_flagged ? "true" : "false") << ",\"text\":\""
       << json_escape(r.cross_text) << "\"}";
@@ -271,19 +271,20 @@ int main(int argc, char** argv) {
   std::filesystem::remove_all(setup.work_dir);
 
   // The table.
-  std::printf("\n| family | kind | right answer | right/n | median outcome | what won (first answer, count) |\n");
-  std::printf("|---|---|---|---|---|---|\n");
+  std::printf("\n| family | kind | right answer | right/n | median outcome | what won (first answer, count) | right added later |\n");
+  std::printf("|---|---|---|---|---|---|---|\n");
   int families_right = 0, families_scored = 0;
   for (const Family& f : families()) {
     std::vector<const RunResult*> rs;
     for (const RunResult& r : runs)
       if (r.family == f.name) rs.push_back(&r);
     if (rs.empty()) continue;
-    int right = 0;
+    int right = 0, later = 0;
     std::map<std::string, int> won;
     std::vector<int> ranks;
     for (const RunResult* r : rs) {
       right += is_right(r->outcome) ? 1 : 0;
+      later += !is_right(r->outcome) && r->right_later ? 1 : 0;
       ++won[answer(*r)];
       ranks.push_back(static_cast<int>(r->outcome));
     }
@@ -298,8 +299,8 @@ int main(int argc, char** argv) {
     std::string what;
     for (std::size_t i = 0; i < order.size() && i < 3; ++i)
       what += (i ? "; " : "") + order[i].second + " x" + std::to_string(-order[i].first);
-    std::printf("| %s | %s | %s | %d/%zu | %s | %s |\n", f.name.c_str(), f.kind.c_str(), f.right_text.c_str(), right,
-                rs.size(), outcome_name(median), what.c_str());
+    std::printf("| %s | %s | %s | %d/%zu | %s | %s | %d |\n", f.name.c_str(), f.kind.c_str(), f.right_text.c_str(), right,
+                rs.size(), outcome_name(median), what.c_str(), later);
   }
   std::printf("\nFalse alarms on clean runs (any first verdict but adequate), per model:\n");
   std::map<std::string, std::pair<int, int>> alarms;  // model -> (alarms, runs)
@@ -333,9 +334,20 @@ int main(int argc, char** argv) {
   std::printf("\nGuarantees over %d traces: %d ended with a parameter outside its bounds, %d with a held-out residual "
               "above where it started; %d runs failed with an error.\n",
               traces, bounds_bad, held_bad, errors);
-  if (cross_runs > 0)
-    std::printf("Harness-side cross-model check (NOT the product): flagged %d of %d clean longitudinal runs.\n", cross_flags,
-                cross_runs);
+  if (cross_runs > 0) {
+    // Per family too: the scale family is where it should fire.
+    std::map<std::string, std::pair<int, int>> by_family;
+    for (const RunResult& r : runs)
+      if (r.cross_checked && r.family.rfind("clean-", 0) != 0) {
+        by_family[r.family].second += 1;
+        by_family[r.family].first += r.cross_flagged ? 1 : 0;
+      }
+    std::printf("Harness-side cross-model check (NOT the product: the two longitudinal models' declared masses more "
+                "than 3 sigma apart): flagged %d of %d clean longitudinal runs",
+                cross_flags, cross_runs);
+    for (const auto& [family, fn] : by_family) std::printf("; %d of %d %s runs", fn.first, fn.second, family.c_str());
+    std::printf(".\n");
+  }
   std::printf("\nTotals: %d of %d families right by median over seeds (target: at least 10 of 12); false alarms %s "
               "(target: at most 1 in 20 per model); %.0f s%s.\n",
               families_right, families_scored, alarms_ok ? "within target" : "ABOVE target", elapsed(),

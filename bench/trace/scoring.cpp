@@ -78,6 +78,10 @@ ModelRun trace_model(const RunSetup& setup, const std::string& name, const inges
   m.held_out_start = start.weighted_rms_held_out;
   m.held_out_end = end.weighted_rms_held_out;
   m.held_out_ok = !(m.held_out_end > m.held_out_start * (1.0 + 1e-9));
+  for (std::size_t i = 0; i < start.parameters.size(); ++i) {
+    m.declared_parameters[start.parameters[i].name] = start.estimate.value(static_cast<Eigen::Index>(i));
+    m.declared_std[start.parameters[i].name] = start.estimate.standard_deviation(static_cast<Eigen::Index>(i));
+  }
   for (std::size_t i = 0; i < end.parameters.size(); ++i) {
     const double v = end.estimate.value(static_cast<Eigen::Index>(i));
     m.final_parameters[end.parameters[i].name] = v;
@@ -94,7 +98,7 @@ std::uint64_t family_seed(const std::string& name, std::uint64_t seed) {
   return std::hash<std::string>{}(name) ^ (seed * 0x9e3779b97f4a7c15ULL);
 }
 
-// Harness-side (not the product): do the two longitudinal models agree on the mass?
+// Harness-side (not the product): do the two longitudinal models, as declared, agree on the mass?
 void cross_check(RunResult& r) {
   const ModelRun* w = nullptr;
   const ModelRun* e = nullptr;
@@ -103,8 +107,8 @@ void cross_check(RunResult& r) {
     if (m.model == "longitudinal_engine") e = &m;
   }
   if (w == nullptr || e == nullptr) return;
-  const double mw = w->final_parameters.at("mass"), me = e->final_parameters.at("mass");
-  const double s = std::hypot(w->final_std.at("mass"), e->final_std.at("mass"));
+  const double mw = w->declared_parameters.at("mass"), me = e->declared_parameters.at("mass");
+  const double s = std::hypot(w->declared_std.at("mass"), e->declared_std.at("mass"));
   r.cross_checked = true;
   r.cross_flagged = std::abs(mw - me) > 3.0 * s;
   r.cross_text = fmt("mass %.0f (wheel) vs %.0f (engine), %.1f sigma", mw, me, std::abs(mw - me) / s);
@@ -156,6 +160,7 @@ RunResult run_family(const RunSetup& setup, const Family& family, std::uint64_t 
       r.models.push_back(trace_model(setup, m, product.recorded, segments, truth.parameters));
     cross_check(r);
     const ModelRun& m = r.models.front();
+    for (const std::string& e : m.added) r.right_later = r.right_later || family.right(e, draw) || family.proxy(e, draw);
     if (family.expect == Expect::kCrossModel) {
       bool hook = false;
       for (const ModelRun& x : r.models) hook = hook || family.right(x.first_effect, draw);

@@ -38,6 +38,8 @@ struct ModelRun {
   double held_out_start = 0.0, held_out_end = 0.0;
   std::map<std::string, double> final_parameters;  ///< name -> value at the loop's end
   std::map<std::string, double> final_std;
+  std::map<std::string, double> declared_parameters;  ///< the declared model's fit (round 0)
+  std::map<std::string, double> declared_std;
   std::string report;  ///< the first diagnosis in full (RunSetup::verbose)
 };
 
@@ -48,8 +50,11 @@ struct RunResult {
   Outcome outcome = Outcome::kError;
   std::vector<ModelRun> models;
   std::string error;
+  /// The right answer (or its proxy) is among the effects the loop added, in any round.
+  bool right_later = false;
   double seconds = 0.0;
-  // Harness-side cross-model check (not the product): the two longitudinal models' masses.
+  // Harness-side cross-model check (not the product): the two longitudinal models' masses as
+  // declared (before the loop adds anything), more than 3 sigma apart.
   bool cross_checked = false;
   bool cross_flagged = false;
   std::string cross_text;
