@@ -146,7 +146,7 @@ std::string answer(const RunResult& r) {
   if (r.outcome == Outcome::kError) return "error: " + r.error;
   std::string out;
   for (const ModelRun& m : r.models) {
-    if (!out.empty()) out += " | ";
+    if (!out.empty()) out += " + ";
     out += m.first_effect.empty() ? m.first_verdict : m.first_effect;
   }
   return out;
