@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 
+#include "dynid/error.hpp"
 #include "dynid/ls/equation_groups.hpp"
 #include "dynid/model/body.hpp"
 #include "dynid/model/channel_set.hpp"
@@ -72,6 +73,40 @@ TEST(Longitudinal, EngineTorqueRecoversMassDragRollingAndGrade) {
   // The accelerometer sees the same grade.
   expect_recovered(identify(*m, run.set, {"road_grade_accelerometer"}),
                    {{"mass", kMass}, {"grade_mass_accelerometer", kMass}});
+}
+
+// A clutch that slips for 0.1 s (a shift): with clutch_slip_margin the rows within that long of
+// a slipping sample are left out too, and reach() says how far a row reads.
+TEST(Longitudinal, TheSlipMarginLeavesOutTheRowsAroundASlippingClutch) {
+  LongitudinalRun run = longitudinal_run(0.0);
+  const Eigen::Index n = run.set.samples();
+  Eigen::VectorXd ratio = Eigen::VectorXd::Constant(n, 6.1), torque(n), engine(n), input(n);
+  for (Eigen::Index k = 0; k < n; ++k) {  // driving: F = eta T G / r; dragging: F = T G / (eta r)
+    const double f = run.force(k);
+    torque(k) = f >= 0 ? f * kRadius / (kEta * 6.1) : f * kRadius * kEta / 6.1;
+  }
+  engine.setConstant(200.0);
+  input.setConstant(200.0);
+  input.segment(2000, 5).setConstant(150.0);  // 5 samples of 0.02 s slip
+  torque.segment(2000, 5).setConstant(-999.0);
+  run.set.add("engine_torque", "N m", torque);
+  run.set.add("gear_ratio", "-", ratio);
+  run.set.add("engine_speed", "rad/s", engine);
+  run.set.add("gearbox_input_speed", "rad/s", input);
+  const model::Constants constants{{"wheel_radius", kRadius}, {"air_density", kRho}, {"driveline_efficiency", kEta}};
+  const Identified plain = identify(*model::make_model("longitudinal_engine", constants), run.set);
+  EXPECT_EQ(plain.rows, static_cast<std::size_t>(n - 200 - 5));
+  model::Constants with_margin = constants;
+  with_margin["clutch_slip_margin"] = 0.1;  // 5 samples each side
+  const auto m = model::make_model("longitudinal_engine", with_margin);
+  const Identified margin = identify(*m, run.set);
+  EXPECT_EQ(margin.rows, static_cast<std::size_t>(n - 200 - 15));
+  expect_recovered(margin, {{"mass", kMass}, {"SCx", kSCx}, {"rolling_resistance", kRolling}});
+  EXPECT_GE(m->reach(0.02).back, 5);
+  EXPECT_GE(m->reach(0.02).ahead, 5);
+  model::Constants negative = constants;
+  negative["clutch_slip_margin"] = -0.1;
+  EXPECT_THROW(model::make_model("longitudinal_engine", negative), InputError);
 }
 
 TEST(Longitudinal, WheelTorqueRecoversOnFlatRoad) {

@@ -26,7 +26,7 @@ ClutchSlipModel::ClutchSlipModel(const Constants& constants) {
 }
 
 Eigen::Index ClutchSlipModel::margin_samples(double sample_period) const {
-  return static_cast<Eigen::Index>(std::ceil(stick_margin_ / sample_period - 1e-9));
+  return detail::margin_samples(stick_margin_, sample_period);
 }
 
 RowReach ClutchSlipModel::reach(double sample_period) const {
@@ -40,15 +40,8 @@ RowReach ClutchSlipModel::reach(double sample_period) const {
 std::vector<bool> ClutchSlipModel::near_stick(const ChannelSet& set) const {
   const Eigen::VectorXd& we = set["engine_speed"];
   const Eigen::VectorXd& wi = set["gearbox_input_speed"];
-  const Eigen::Index n = set.samples();
-  const Eigen::Index reach = margin_samples(set.sample_period());
-  std::vector<bool> out(static_cast<std::size_t>(n), false);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    if (std::abs(we(k) - wi(k)) >= min_slip_) continue;
-    for (Eigen::Index j = std::max<Eigen::Index>(0, k - reach); j <= std::min(n - 1, k + reach); ++j)
-      out[static_cast<std::size_t>(j)] = true;
-  }
-  return out;
+  return detail::within_margin_of(set.samples(), margin_samples(set.sample_period()),
+                                  [&](Eigen::Index k) { return std::abs(we(k) - wi(k)) < min_slip_; });
 }
 
 std::function<double(double)> ClutchSlipModel::clamp_load() const {

@@ -25,6 +25,9 @@ LongitudinalModel::LongitudinalModel(const Constants& constants, Source source) 
   min_speed_ = c.positive_or("min_speed", 1.0);
   brake_threshold_ = c.positive_or("brake_pressure_threshold", 2e4);
   slip_tolerance_ = c.positive_or("clutch_slip_tolerance", 1.0);
+  slip_margin_ = c.optional("clutch_slip_margin").value_or(0.0);
+  // A negative margin is an error: positive() throws naming the constant.
+  if (slip_margin_ < 0.0) slip_margin_ = c.positive("clutch_slip_margin", "s, >= 0");
   wheel_torque_zero_ = c.optional("wheel_torque_zero").value_or(0.0);
 }
 
@@ -141,6 +144,15 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
   return out;
 }
 
+RowReach LongitudinalModel::reach(double sample_period) const {
+  RowReach r = Model::reach(sample_period);
+  if (source_ != Source::kEngineTorque) return r;
+  const Eigen::Index margin = detail::margin_samples(slip_margin_, sample_period);
+  r.back = std::max(r.back, margin);
+  r.ahead = std::max(r.ahead, margin);
+  return r;
+}
+
 RowModel::RowFn LongitudinalModel::bind(const ChannelSet& set,
                                         const std::vector<std::string>& effects) const {
   const Eigen::VectorXd& vx = set["vx"];
@@ -148,12 +160,16 @@ RowModel::RowFn LongitudinalModel::bind(const ChannelSet& set,
   const Eigen::VectorXd* engine = detail::find(set, "engine_speed");
   const Eigen::VectorXd* input = detail::find(set, "gearbox_input_speed");
   const bool slip_check = source_ == Source::kEngineTorque && engine != nullptr && input != nullptr;
+  const std::vector<bool> slipping =
+      slip_check ? detail::within_margin_of(set.samples(), detail::margin_samples(slip_margin_, set.sample_period()),
+                                            [&](Eigen::Index k) { return std::abs((*engine)(k) - (*input)(k)) > slip_tolerance_; })
+                 : std::vector<bool>{};
   auto braking = detail::braking(set, brake_threshold_, enabled(effects, effect::kBrakeDrag));
   const double half_rho = 0.5 * air_density_;
   return [=, this, &vx, &dvx, drive = drive(set)](Eigen::Index k, std::size_t, double* w,
                                                    double& y) {
     if (std::abs(vx(k)) < min_speed_ || braking(k)) return false;
-    if (slip_check && std::abs((*engine)(k) - (*input)(k)) > slip_tolerance_) return false;
+    if (slip_check && slipping[static_cast<std::size_t>(k)]) return false;
     w[0] = dvx(k);
     w[1] = half_rho * detail::signed_square(vx(k));
     w[2] = detail::sgn(vx(k));

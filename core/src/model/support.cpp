@@ -1,5 +1,8 @@
 #include "support.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "dynid/error.hpp"
 
 namespace dynid::model::detail {
@@ -51,6 +54,21 @@ std::string opposite_corner(const std::string& corner, const std::string& model)
   if (corner == "rl") return "rr";
   if (corner == "rr") return "rl";
   throw InputError("model '" + model + "': unknown corner '" + corner + "' (fl, fr, rl, rr)");
+}
+
+std::vector<bool> within_margin_of(Eigen::Index samples, Eigen::Index margin,
+                                   const std::function<bool(Eigen::Index)>& flagged) {
+  std::vector<bool> out(static_cast<std::size_t>(samples), false);
+  for (Eigen::Index k = 0; k < samples; ++k) {
+    if (!flagged(k)) continue;
+    for (Eigen::Index j = std::max<Eigen::Index>(0, k - margin); j <= std::min(samples - 1, k + margin); ++j)
+      out[static_cast<std::size_t>(j)] = true;
+  }
+  return out;
+}
+
+Eigen::Index margin_samples(double margin_s, double sample_period) {
+  return static_cast<Eigen::Index>(std::ceil(margin_s / sample_period - 1e-9));
 }
 
 }  // namespace dynid::model::detail

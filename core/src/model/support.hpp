@@ -82,6 +82,14 @@ std::function<bool(Eigen::Index)> braking(const ChannelSet& set, double threshol
 /// The value of a channel at k (bound once).
 ValueFn channel(const ChannelSet& set, const std::string& name);
 
+/// The samples within `margin` of a sample where `flagged(k)` holds, over `samples` samples: the
+/// rows a low-passed transient reaches (the filter spreads it over its impulse response).
+std::vector<bool> within_margin_of(Eigen::Index samples, Eigen::Index margin,
+                                   const std::function<bool(Eigen::Index)>& flagged);
+
+/// A margin in seconds as whole samples at `sample_period` (rounded up).
+Eigen::Index margin_samples(double margin_s, double sample_period);
+
 /// The brake-drag effect: a force or torque k_b p proportional to brake pressure, on the
 /// resisting side; `parameter_name`, `unit` of k_b.
 RowModel::EffectDefinition brake_drag(const std::string& parameter_name, const std::string& unit);

@@ -23,7 +23,10 @@
 //
 // Constants: wheel_radius (m), air_density (kg/m^3), driveline_efficiency (engine source,
 // 0 < eta <= 1); optional gravity (9.80665), min_speed (1 m/s), brake_pressure_threshold
-// (2e4 Pa), clutch_slip_tolerance (1 rad/s), wheel_torque_zero (N m, 0: wheel source).
+// (2e4 Pa), clutch_slip_tolerance (1 rad/s), clutch_slip_margin (s, 0: the rows within that
+// long of a slipping sample are left out too, because the low-pass spreads a shift's transient
+// over its impulse response; clutch_slip.hpp's stick_margin is the same for the clutch model),
+// wheel_torque_zero (N m, 0: wheel source).
 //
 // wheel_torque_zero: what the wheel-torque meter reads at zero torque, from the run's tare
 // (ingest/zero_calibration.hpp: standing in neutral or with the clutch open, the driveshafts
@@ -57,6 +60,7 @@ class LongitudinalModel final : public RowModel {
  protected:
   std::vector<EffectDefinition> effect_definitions() const override;
   RowFn bind(const ChannelSet& channels, const std::vector<std::string>& effects) const override;
+  RowReach reach(double sample_period) const override;
 
  private:
   // The per-sample drive force and its factor F_drive / T (eta^s G / r_w or 1 / r_w).
@@ -74,6 +78,7 @@ class LongitudinalModel final : public RowModel {
   double min_speed_;
   double brake_threshold_;
   double slip_tolerance_;
+  double slip_margin_ = 0.0;  // s
   double wheel_torque_zero_ = 0.0;  // N m
 };
 
