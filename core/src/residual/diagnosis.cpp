@@ -210,25 +210,58 @@ double lowest_ratio(const GroupFloor& g, std::size_t groups) {
   return std::exp(-z * g.log_ratio_std);
 }
 
-// The first significant candidate in the screen's ranking that does not take the residual below
-// the floor; the ones that do are refused with the reason.
-void accept_best(Diagnosis& d) {
+// The sensors a candidate reads beyond the model's own columns: a physical effect's channels, a
+// dictionary term's or a delay's channel.
+std::vector<std::string> sensors_of(const CandidateScore& c, const std::vector<model::Effect>& effects) {
+  for (const model::Effect& e : effects)
+    if (e.name == c.effect) return e.channels;
+  for (const char* prefix : {"dict:", "delay:"}) {
+    if (c.effect.rfind(prefix, 0) != 0) continue;
+    std::string channel = c.effect.substr(c.effect.rfind(':') + 1);
+    return {channel.substr(0, channel.find('@'))};
+  }
+  return {};
+}
+
+// The group whose residual `c` takes below the floor, or nullptr.
+const GroupFloor* below_floor(const CandidateScore& c, const NoiseFloor& floor) {
+  const double kept = (1.0 - c.in_sample_drop) * (1.0 - c.in_sample_drop);
+  for (const GroupFloor& g : floor.groups)
+    if (g.rows > 0 && g.ratio * kept < lowest_ratio(g, floor.groups.size())) return &g;
+  return nullptr;
+}
+
+// Among the significant candidates, those that take the residual below the floor are refused,
+// and with them every candidate that reads the same sensor (a lag of the accelerometer is the
+// accelerometer, a little worse: measured on bench/trace, it won every run with vx late); the
+// one-standard-error rule then picks among the rest.
+void accept_best(Diagnosis& d, const model::Model& model) {
+  const std::vector<model::Effect> effects = model.candidate_effects();
+  std::vector<std::string> refused_sensors;
+  std::vector<CandidateScore> eligible;
   for (const CandidateScore& c : d.screen.candidates) {
     if (!c.significant) break;  // ranked: the significant ones come first
-    const double kept = (1.0 - c.in_sample_drop) * (1.0 - c.in_sample_drop);
-    const GroupFloor* under = nullptr;
-    for (const GroupFloor& g : d.floor.groups)
-      if (g.rows > 0 && g.ratio * kept < lowest_ratio(g, d.floor.groups.size())) under = &g;
-    if (under == nullptr) {
-      d.accepted = c;
-      return;
+    const std::vector<std::string> sensors = sensors_of(c, effects);
+    const auto same = std::find_first_of(sensors.begin(), sensors.end(), refused_sensors.begin(), refused_sensors.end());
+    if (same != sensors.end()) {
+      d.refused.push_back({c.effect, "reads " + *same + ", the sensor refused above as a better sensor of a declared signal"});
+      continue;
     }
-    d.refused.push_back({c.effect, "takes the " + under->group + " residual below the noise floor" +
-                                       format(" (ratio of squares %.2g, at least %.2g expected)",
-                                              under->ratio * kept, lowest_ratio(*under, d.floor.groups.size())) +
-                                       ": it fits the noise of a declared signal (a better sensor of it), "
-                                       "not a missing effect"});
+    if (const GroupFloor* under = below_floor(c, d.floor)) {
+      const double kept = (1.0 - c.in_sample_drop) * (1.0 - c.in_sample_drop);
+      d.refused.push_back({c.effect, "takes the " + under->group + " residual below the noise floor" +
+                                         format(" (ratio of squares %.2g, at least %.2g expected)", under->ratio * kept,
+                                                lowest_ratio(*under, d.floor.groups.size())) +
+                                         ": it fits the noise of a declared signal (a better sensor of it), "
+                                         "not a missing effect"});
+      refused_sensors.insert(refused_sensors.end(), sensors.begin(), sensors.end());
+      continue;
+    }
+    eligible.push_back(c);
   }
+  if (eligible.empty()) return;
+  prefer_simplest_within_one_error(eligible);
+  d.accepted = eligible.front();
 }
 
 }  // namespace
@@ -242,7 +275,21 @@ const char* verdict_name(Verdict verdict) {
   return "?";
 }
 
+namespace {
+
+std::string implausible_text(const std::vector<std::string>& implausible) {
+  std::string out;
+  for (const std::string& i : implausible) out += (out.empty() ? "" : "; ") + i;
+  return out.empty() ? out : "; the model as declared is implausible on this run: " + out;
+}
+
+}  // namespace
+
 std::string Diagnosis::statement() const {
+  return verdict_statement() + implausible_text(implausible);
+}
+
+std::string Diagnosis::verdict_statement() const {
   std::string floors;
   for (const GroupFloor& g : floor.groups)
     if (g.rows > 0)
@@ -283,6 +330,13 @@ std::string Diagnosis::statement() const {
   return out;
 }
 
+std::string out_of_bounds(const model::ParameterInfo& info, double value, double std) {
+  const double margin = 2.0 * (std::isfinite(std) ? std : 0.0);
+  if (!std::isfinite(value) || info.within_bounds(value - margin) || info.within_bounds(value + margin)) return {};
+  return info.name + format(" = %.4g +- %.2g ", value, std) + info.unit + ", outside its physical bounds (" +
+         info.bounds_text() + ") by more than two standard deviations";
+}
+
 Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
                    const ingest::RecordedRun& run, const DiagnosisOptions& options) {
   return diagnose(model, declared, run, ingest::preprocess_offline(run), options);
@@ -296,16 +350,23 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
   const int odmf = run.announcement.preprocessing.odmf;
   Diagnosis d;
   d.screen = screen_effects(model, declared, segments, rate, odmf, options.screen);
-  d.inseparable = inseparable_effects(model, d.screen);
+  const ls::Estimate& fit = d.screen.fit.estimate;
+  for (std::size_t j = 0; j < d.screen.fit.parameters.size(); ++j) {
+    const auto i = static_cast<Eigen::Index>(j);
+    if (std::string why = out_of_bounds(d.screen.fit.parameters[j], fit.value(i), fit.standard_deviation(i)); !why.empty())
+      d.implausible.push_back(std::move(why));
+  }
   NoiseFloorOptions floor_options = options.floor;
   floor_options.fit = options.screen.fit;
   d.floor = noise_floor(model, declared, run, segments,
                         measure_channel_noise(run, segments, options.declared_noise), floor_options);
   if (d.floor.adequate()) {
     d.verdict = Verdict::kAdequate;
+    d.inseparable = inseparable_effects(model, d.screen);
     return d;
   }
-  accept_best(d);
+  accept_best(d, model);
+  d.inseparable = inseparable_effects(model, d.screen, d.accepted ? d.accepted->effect : "");
   d.verdict = d.accepted ? Verdict::kExplained : Verdict::kStructureLeft;
   const SignatureInputs in{model, segments, d.screen.fit, d.floor, rate, odmf,
                            options.screen.fit.cross_validation.block_seconds};

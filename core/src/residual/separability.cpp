@@ -22,7 +22,7 @@ std::optional<Inseparable> worst_shift(const model::Model& model, const ScreenRe
     const auto i = static_cast<Eigen::Index>(j);
     const double std_j = e.standard_deviation(i);
     if (!std::isfinite(std_j) || std_j <= 0.0 || !std::isfinite(e.value(i))) continue;
-    const double shift = c.alias[j] * c.detectable;
+    const double shift = c.alias[j] * (c.significant ? c.coefficient : c.detectable);
     if (std::abs(shift) / std_j <= std::abs(out.shift_in_std)) continue;
     out.parameter = screen.fit.parameters[j].name;
     out.shift = shift;
@@ -43,18 +43,22 @@ std::string Inseparable::statement() const {
                   effect.c_str(), separated_by.c_str());
     return buf;
   }
-  std::snprintf(buf, sizeof buf,
-                "%s cannot be separated on this run: up to %.3g %s would pass unseen (80 %% power) and move %s by "
-                "%+.3g (%+.1f %%, %.1f std); to separate it: %s",
-                effect.c_str(), std::abs(detectable), unit.c_str(), parameter.c_str(), shift, 100.0 * shift_relative,
-                std::abs(shift_in_std), separated_by.c_str());
+  const std::string size = significant ? "its fitted %.3g %s, significant under the noise floor, would"
+                                        : "up to %.3g %s would pass unseen (80 %% power) and";
+  const std::string pattern = "%s cannot be separated on this run: " + size +
+                              " move %s by %+.3g (%+.1f %%, %.1f std); to separate it: %s";
+  std::snprintf(buf, sizeof buf, pattern.c_str(), effect.c_str(), significant ? detectable : std::abs(detectable),
+                unit.c_str(), parameter.c_str(), shift, 100.0 * shift_relative, std::abs(shift_in_std),
+                separated_by.c_str());
   return buf;
 }
 
-std::vector<Inseparable> inseparable_effects(const model::Model& model, const ScreenResult& screen) {
+std::vector<Inseparable> inseparable_effects(const model::Model& model, const ScreenResult& screen,
+                                             const std::string& accepted) {
   std::vector<Inseparable> out;
   for (const CandidateScore& c : screen.candidates) {
-    if (c.kind != CandidateKind::kPhysics || !c.evaluated || c.significant || c.columns != 1) continue;
+    if (c.kind != CandidateKind::kPhysics || !c.evaluated || c.effect == accepted || c.columns != 1) continue;
+    if (c.significant && !accepted.empty()) continue;  // a rival of the accepted one, in the ranking
     std::optional<Inseparable> found;
     if (!c.testable) {
       found = Inseparable{};
@@ -66,7 +70,8 @@ std::vector<Inseparable> inseparable_effects(const model::Model& model, const Sc
     if (!found) continue;
     found->effect = c.effect;
     found->description = c.description;
-    found->detectable = c.detectable;
+    found->significant = c.significant;
+    found->detectable = c.significant ? c.coefficient : c.detectable;
     found->unit = c.coefficient_unit;
     out.push_back(std::move(*found));
   }

@@ -12,17 +12,10 @@ std::string refusal(const EffectComparison& c) {
   if (!(c.held_out_drop() > 0.0))
     return c.effect + " refused: with it the held-out residual is not lower (" +
            std::to_string(100.0 * -c.held_out_drop()) + " %)";
-  // Out of bounds by more than two standard deviations: a parameter that may truly be near a
-  // bound (a rolling resistance near 0) falls on the wrong side of it by noise half the time.
-  for (std::size_t i = 0; i < c.parameters.size() && i < c.after.parameters.size(); ++i) {
-    const model::ParameterInfo& info = c.after.parameters[i];
-    const ParameterChange& p = c.parameters[i];
-    const double margin = 2.0 * (std::isfinite(p.std_after) ? p.std_after : 0.0);
-    if (!info.within_bounds(p.after - margin) && !info.within_bounds(p.after + margin))
-      return c.effect + " refused: it takes " + info.name + " to " + std::to_string(p.after) + " +- " +
-             std::to_string(p.std_after) + " " + info.unit + ", outside its physical bounds (" + info.bounds_text() +
-             ") by more than two standard deviations";
-  }
+  for (std::size_t i = 0; i < c.parameters.size() && i < c.after.parameters.size(); ++i)
+    if (const std::string why = out_of_bounds(c.after.parameters[i], c.parameters[i].after, c.parameters[i].std_after);
+        !why.empty())
+      return c.effect + " refused: it takes " + why;
   return {};
 }
 
@@ -63,7 +56,7 @@ Trace trace(const model::Model& model, const std::vector<std::string>& declared,
     EffectComparison c = compare_effect(model, effects, r.diagnosis.accepted->effect, segments, rate, odmf,
                                         options.diagnosis.screen.fit, options.reference);
     if (const std::string why = refusal(c); !why.empty()) {
-      t.stopped = why;
+      t.stopped = why + (r.diagnosis.implausible.empty() ? "" : "; the model as it stands is implausible on this run");
       t.rounds.push_back(std::move(r));
       return t;
     }

@@ -214,6 +214,7 @@ json diagnosis_object(const residual::Diagnosis& d) {
           {"candidates", candidates},
           {"refused", refused},
           {"inseparable", inseparable},
+          {"implausible", d.implausible},
           {"signature",
            {{"correlations", correlations},
             {"span_group", d.signature.span_group},

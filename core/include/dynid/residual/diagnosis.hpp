@@ -84,10 +84,21 @@ struct Diagnosis {
   /// rescales the fit (a head wind against drag and rolling resistance) leaves the residual at
   /// the floor.
   std::vector<Inseparable> inseparable;
+  /// Declared parameters outside their model's physical bounds by more than two standard
+  /// deviations (out_of_bounds), whatever the verdict: the model as declared is implausible on
+  /// this run, and an effect it lacks (or a run that does not excite it) is the likely reason.
+  std::vector<std::string> implausible;
   Verdict verdict = Verdict::kAdequate;
-  /// One paragraph: the verdict and its evidence.
+  /// One paragraph: the verdict and its evidence, and the declared parameters it finds implausible.
   std::string statement() const;
+  /// The verdict and its evidence alone.
+  std::string verdict_statement() const;
 };
+
+/// Why `value` +- `std` is implausible for `info`: outside its physical bounds by more than two
+/// standard deviations (a parameter that may truly lie near a bound, a rolling resistance near 0,
+/// falls on the wrong side of it by noise half the time); empty when it is not.
+std::string out_of_bounds(const model::ParameterInfo& info, double value, double std);
 
 /// Diagnoses `model` with its `declared` effects on `run` (assembled, not preprocessed: the
 /// floor needs the raw samples). InputError as screen_effects.

@@ -38,16 +38,17 @@
 // low-passed, decimated rows: an ordinary F test counts correlated rows as independent evidence.
 // The held-out condition guards the small-sample side of the asymptotic test.
 //
-// Ranking: significant candidates first; among them the model's physical effects first (each
-// has a meaning and parameters an engineer can use; the dictionary holds other sensors of the
-// same forces: a lag of the accelerometer fits a grade better than the grade channel itself,
-// because it also stands in for the noisy wheel-speed derivative, measured); then by held-out
-// drop, the predictive criterion (a candidate with many columns, a road profile, pays for them
-// on held-out rows). Among the rest, the one-standard-error rule of cross-validated model
-// choice (Hastie, Tibshirani and Friedman) prefers the earlier kind, road profile, signal
-// timing, varying parameter, dictionary: the best candidate of the first kind within one
-// standard error of the best one's held-out error (the paired difference of their per-fold log
-// ratios) goes first.
+// Ranking: significant candidates first, by held-out drop, the predictive criterion (a
+// candidate with many columns, a road profile, pays for them on held-out rows). Then the
+// one-standard-error rule of cross-validated model choice (Hastie, Tibshirani and Friedman)
+// prefers the earlier kind, physics, road profile, signal timing, varying parameter,
+// dictionary: the best significant candidate of the first kind within one standard error of
+// the best one's held-out error (the paired difference of their per-fold log ratios) goes
+// first. Physics is the simplest kind (each effect has a meaning and parameters an engineer can
+// use), not a tier above the rest:
+// - Why not physics first whatever its gain: on a car whose accelerometer is its only grade
+//   sensor, road_grade_accelerometer is significant in nearly every run (it is a better sensor
+//   of d_vx), and won a mass step at -4 % held out against step:mass's -77 % (bench/trace).
 // - Why not fixed tiers there: a weak varying candidate (a step of the offset, -8 % held out)
 //   ranked above the road profile that explained a grade (-56 %).
 // - Why timing is not physics: a delay of the yaw rate stands in for a road bank as its
@@ -137,6 +138,11 @@ struct ScreenResult {
   /// One sentence: what explains the residual, or that nothing significant was found.
   std::string verdict() const;
 };
+
+/// The one-standard-error rule over `ranked` (significant candidates first, by held-out drop):
+/// the best significant candidate of the earliest kind within one standard error of the first
+/// moves to the front (see above). The diagnosis applies it again once it has refused some.
+void prefer_simplest_within_one_error(std::vector<CandidateScore>& ranked);
 
 ScreenResult screen_effects(const model::Model& model, const std::vector<std::string>& declared,
                             const std::vector<ingest::PreprocessedSegment>& run,

@@ -5,7 +5,7 @@
 // parameters it would bias and by how much, and the manoeuvre that would separate it").
 //
 // The argument is a power calculation, not a collinearity threshold. For each physical
-// candidate effect of one column that the screen did not find significant (effect_screen.hpp),
+// candidate effect of one column that the diagnosis did not accept (effect_screen.hpp),
 // the screen states the smallest coefficient its test would have found with 80 % power
 // (`detectable`) and how far each declared parameter moves per unit of that coefficient when the
 // effect is left out (`alias`, the omitted-variable identity). An effect of the detectable size
@@ -13,7 +13,9 @@
 // parameter by more than kShiftInStd of that parameter's standard deviations, i.e. when the
 // parameter's stated uncertainty does not cover what the run cannot rule out. A candidate whose
 // column is a combination of the declared ones on this run (not testable) is reported as not
-// identifiable at all.
+// identifiable at all. A candidate that is significant but not accepted (the residual is at
+// the floor: a structure smaller than the noise) is judged by its fitted coefficient instead: a
+// head wind's linear term, significant at the floor, that would move SCx by 50 of its std.
 //
 // The manoeuvre that would separate it: the effect's own model::Effect::separated_by when the
 // model states one (a head wind and tyre losses: coast-downs in both directions of one road),
@@ -33,7 +35,9 @@ struct Inseparable {
   std::string effect;
   std::string description;
   bool identifiable = true;  ///< false: its column is a combination of the declared ones here
-  double detectable = 0.0;   ///< the smallest coefficient the screen would find (80 % power)
+  bool significant = false;  ///< the screen found it, the diagnosis did not accept it
+  double detectable = 0.0;   ///< the smallest coefficient the screen would find (80 % power);
+                             ///< for a significant one, its fitted coefficient
   std::string unit;          ///< of detectable
   std::string parameter;     ///< the declared parameter it would move most, in its std
   double shift = 0.0;        ///< that parameter's move at `detectable`, in its unit
@@ -44,8 +48,9 @@ struct Inseparable {
   std::string statement() const;
 };
 
-/// The physical candidates of `screen` that this run cannot separate (see above), the largest
-/// shift (in std) first.
-std::vector<Inseparable> inseparable_effects(const model::Model& model, const ScreenResult& screen);
+/// The physical candidates of `screen` but `accepted` that this run cannot separate (see
+/// above), the largest shift (in std) first.
+std::vector<Inseparable> inseparable_effects(const model::Model& model, const ScreenResult& screen,
+                                             const std::string& accepted = "");
 
 }  // namespace dynid::residual
