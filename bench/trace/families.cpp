@@ -98,7 +98,7 @@ std::vector<Family> make_families() {
                draw_value(&Perturbation::head_wind, 5.0, 10.0, "head wind %.1f m/s"),
                [](const std::string& e, const Draw&) { return e == "linear_drag"; },
                [](const std::string& e, const Draw&) { return starts(e, "dict:x:vx"); },
-               "dict:x:vx (the same column as linear_drag)"});
+               "dict:x:vx (the same column as linear_drag)", true});
   f.push_back({"brake_drag", "physics", Manoeuvre::kLongitudinal, {"longitudinal_wheel"}, Expect::kCandidate,
                "brake_drag (the driver rides the brake below the profile's 1 bar mask)",
                draw_value(&Perturbation::brake_drag_pressure, 0.2e5, 0.55e5, "%.2f bar mean brake drag", 1e-5),

@@ -39,6 +39,9 @@ struct Family {
   /// A labelled first-order proxy (empty label: none counts).
   std::function<bool(const std::string& effect, const Draw&)> proxy;
   std::string proxy_label;
+  /// "Reported as cannot be separated on this run" (separability.hpp) counts as right: the
+  /// issue's answer for an effect nearly collinear with the declared columns (a head wind).
+  bool inseparable_is_right = false;
 };
 
 const std::vector<Family>& families();

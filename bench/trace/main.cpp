@@ -120,7 +120,7 @@ std::string json_run(const RunResult& r) {
     << "\",\"outcome\":\"" << outcome_name(r.outcome) << "\",\"seconds\":" << r.seconds << ",\"error\":\""
     << json_escape(r.error) << "\",\"right_added_later\":" << (r.right_later ? "true" : "false");
   if (r.cross_checked)
-    o << ",\"harness_cross_model_check\":{\"flagged\":" << (r.cross_flagged ? "true" : "false") << ",\"text\":\""
+    o << ",\"consistency\":{\"flagged\":" << (r.cross_flagged ? "true" : "false") << ",\"text\":\""
       << json_escape(r.cross_text) << "\"}";
   o << ",\"models\":[";
   for (std::size_t i = 0; i < r.models.size(); ++i) {
@@ -166,7 +166,7 @@ void print_run(const RunResult& r) {
     if (!m.held_out_ok) std::printf("; HELD-OUT WORSE %.4g -> %.4g", m.held_out_start, m.held_out_end);
     std::printf("\n%s", m.report.c_str());
   }
-  if (r.cross_checked) std::printf("      harness-side cross-model check (not the product): %s%s\n", r.cross_text.c_str(), r.cross_flagged ? ", FLAGGED" : "");
+  if (r.cross_checked) std::printf("      consistency (dynid consistency): %s%s\n", r.cross_text.c_str(), r.cross_flagged ? ", FLAGGED" : "");
   std::fflush(stdout);
 }
 
@@ -342,8 +342,8 @@ int main(int argc, char** argv) {
         by_family[r.family].second += 1;
         by_family[r.family].first += r.cross_flagged ? 1 : 0;
       }
-    std::printf("Harness-side cross-model check (NOT the product: the two longitudinal models' declared masses more "
-                "than 3 sigma apart): flagged %d of %d clean longitudinal runs",
+    std::printf("Consistency check of the product (dynid consistency: the models' shared parameters within their HAC "
+                "std, 1 %% family error rate): inconsistent in %d of %d clean runs with two models or more",
                 cross_flags, cross_runs);
     for (const auto& [family, fn] : by_family) std::printf("; %d of %d %s runs", fn.first, fn.second, family.c_str());
     std::printf(".\n");

@@ -1,5 +1,6 @@
 #include "scoring.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include "car/parameters.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/report/residual_report.hpp"
+#include "dynid/residual/consistency.hpp"
 #include "dynid/residual/model_fit.hpp"
 
 namespace dynid::benchtrace {
@@ -52,6 +54,7 @@ ModelRun trace_model(const RunSetup& setup, const std::string& name, const inges
       m.first_ratio = g.ratio;
       m.first_upper = g.upper_ratio;
     }
+  for (const residual::Inseparable& i : first.inseparable) m.first_inseparable.push_back(i.effect);
   if (first.verdict == residual::Verdict::kStructureLeft) m.signature = signature_text(first.signature);
   if (setup.verbose) {
     m.report = report::format_diagnosis_text(first, 8);
@@ -98,20 +101,24 @@ std::uint64_t family_seed(const std::string& name, std::uint64_t seed) {
   return std::hash<std::string>{}(name) ^ (seed * 0x9e3779b97f4a7c15ULL);
 }
 
-// Harness-side (not the product): do the two longitudinal models, as declared, agree on the mass?
-void cross_check(RunResult& r) {
-  const ModelRun* w = nullptr;
-  const ModelRun* e = nullptr;
-  for (const ModelRun& m : r.models) {
-    if (m.model == "longitudinal_wheel") w = &m;
-    if (m.model == "longitudinal_engine") e = &m;
+// The product's consistency check (residual/consistency.hpp) over the run's models as declared:
+// shared parameters compared within their HAC std. Flagged: a significant disagreement.
+void cross_check(const RunSetup& setup, const std::vector<std::string>& models,
+                 const std::vector<ingest::PreprocessedSegment>& segments, const ingest::RecordedRun& run,
+                 RunResult& r) {
+  if (models.size() < 2) return;
+  std::vector<residual::ModelParameters> fits;
+  for (const std::string& name : models) {
+    const ingest::ModelSpec spec = benchcar::model_spec(*setup.profile, name);
+    const auto model = model::make_model(spec.model, spec.constants);
+    fits.push_back(residual::hac_parameters(*model, spec.effects, segments, run.announcement.sample_rate_hz,
+                                            run.announcement.preprocessing.odmf));
   }
-  if (w == nullptr || e == nullptr) return;
-  const double mw = w->declared_parameters.at("mass"), me = e->declared_parameters.at("mass");
-  const double s = std::hypot(w->declared_std.at("mass"), e->declared_std.at("mass"));
-  r.cross_checked = true;
-  r.cross_flagged = std::abs(mw - me) > 3.0 * s;
-  r.cross_text = fmt("mass %.0f (wheel) vs %.0f (engine), %.1f sigma", mw, me, std::abs(mw - me) / s);
+  const residual::Consistency c = residual::check_consistency(fits, {});
+  r.cross_checked = !c.comparisons.empty();
+  r.cross_flagged = !c.consistent();
+  r.cross_one_ratio = !c.scales.empty() && c.scales.front().one_ratio;
+  r.cross_text = c.statement();
 }
 
 }  // namespace
@@ -121,16 +128,18 @@ const char* outcome_name(Outcome o) {
     case Outcome::kRight: return "right";
     case Outcome::kProxy: return "proxy";
     case Outcome::kStructureRight: return "structure-left (right)";
+    case Outcome::kInseparable: return "reported inseparable";
     case Outcome::kWrong: return "wrong";
     case Outcome::kMissed: return "missed (adequate)";
     case Outcome::kStructureMissed: return "missed (structure left)";
-    case Outcome::kNoHook: return "missed (no product hook)";
     case Outcome::kError: return "error";
   }
   return "?";
 }
 
-bool is_right(Outcome o) { return o == Outcome::kRight || o == Outcome::kProxy || o == Outcome::kStructureRight; }
+bool is_right(Outcome o) {
+  return o == Outcome::kRight || o == Outcome::kProxy || o == Outcome::kStructureRight || o == Outcome::kInseparable;
+}
 
 residual::ModelFit declared_fit(const car::VehicleProfile& profile, const std::string& name, const ingest::RecordedRun& run) {
   const ingest::ModelSpec spec = benchcar::model_spec(profile, name);
@@ -158,18 +167,19 @@ RunResult run_family(const RunSetup& setup, const Family& family, std::uint64_t 
     const auto segments = ingest::preprocess_offline(product.recorded);
     for (const std::string& m : family.models)
       r.models.push_back(trace_model(setup, m, product.recorded, segments, truth.parameters));
-    cross_check(r);
+    cross_check(setup, family.models, segments, product.recorded, r);
     const ModelRun& m = r.models.front();
     for (const std::string& e : m.added) r.right_later = r.right_later || family.right(e, draw) || family.proxy(e, draw);
     if (family.expect == Expect::kCrossModel) {
-      bool hook = false;
-      for (const ModelRun& x : r.models) hook = hook || family.right(x.first_effect, draw);
-      r.outcome = hook ? Outcome::kRight : Outcome::kNoHook;
-      if (!hook)
-        for (const ModelRun& x : r.models)
-          if (!x.first_effect.empty()) r.outcome = Outcome::kWrong;
+      // Right: the consistency check finds the two models off by one common ratio (a scale).
+      r.outcome = r.cross_flagged && r.cross_one_ratio ? Outcome::kRight
+                                                       : (r.cross_flagged ? Outcome::kWrong : Outcome::kMissed);
     } else if (m.first_verdict == "adequate") {
-      r.outcome = Outcome::kMissed;
+      // The "cannot be separated on this run": the right effect, named as one this run
+      // cannot rule out although it would bias the declared parameters.
+      const bool reported = std::any_of(m.first_inseparable.begin(), m.first_inseparable.end(),
+                                        [&](const std::string& e) { return family.right(e, draw); });
+      r.outcome = reported && family.inseparable_is_right ? Outcome::kInseparable : Outcome::kMissed;
     } else if (m.first_verdict == "structure left") {
       r.outcome = family.expect == Expect::kStructureLeft ? Outcome::kStructureRight : Outcome::kStructureMissed;
     } else if (family.right(m.first_effect, draw)) {
@@ -206,7 +216,7 @@ RunResult run_clean(const RunSetup& setup, benchcar::Manoeuvre manoeuvre, const 
       r.models.push_back(trace_model(setup, m, product.recorded, segments, truth.parameters));
       alarm = alarm || r.models.back().first_verdict != "adequate";
     }
-    cross_check(r);
+    cross_check(setup, models, segments, product.recorded, r);
     r.outcome = alarm ? Outcome::kWrong : Outcome::kRight;
   } catch (const std::exception& e) {
     r.outcome = Outcome::kError;

@@ -17,7 +17,7 @@
 
 namespace dynid::benchtrace {
 
-enum class Outcome { kRight, kProxy, kStructureRight, kWrong, kMissed, kStructureMissed, kNoHook, kError };
+enum class Outcome { kRight, kProxy, kStructureRight, kInseparable, kWrong, kMissed, kStructureMissed, kError };
 const char* outcome_name(Outcome o);
 /// Counts as the right answer (right physics, labelled proxy, or structure left where expected).
 bool is_right(Outcome o);
@@ -38,6 +38,8 @@ struct ModelRun {
   double held_out_start = 0.0, held_out_end = 0.0;
   std::map<std::string, double> final_parameters;  ///< name -> value at the loop's end
   std::map<std::string, double> final_std;
+  /// The physical effects the first diagnosis says this run cannot separate (separability.hpp).
+  std::vector<std::string> first_inseparable;
   std::map<std::string, double> declared_parameters;  ///< the declared model's fit (round 0)
   std::map<std::string, double> declared_std;
   std::string report;  ///< the first diagnosis in full (RunSetup::verbose)
@@ -53,10 +55,11 @@ struct RunResult {
   /// The right answer (or its proxy) is among the effects the loop added, in any round.
   bool right_later = false;
   double seconds = 0.0;
-  // Harness-side cross-model check (not the product): the two longitudinal models' masses as
-  // declared (before the loop adds anything), more than 3 sigma apart.
+  // The product's consistency check over the run's models as declared (residual/consistency.hpp):
+  // any shared parameter beyond its level; and whether one common ratio explains it (a scale).
   bool cross_checked = false;
   bool cross_flagged = false;
+  bool cross_one_ratio = false;
   std::string cross_text;
 };
 
