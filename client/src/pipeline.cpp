@@ -1,5 +1,7 @@
 #include "dynid/car/pipeline.hpp"
 
+#include <cmath>
+
 namespace dynid::car {
 namespace {
 
@@ -27,12 +29,22 @@ CarPipeline::CarPipeline(const VehicleProfile& profile, const std::string& run,
                    builder_.add_row(k, row, valid);
                  }) {}
 
+double CarPipeline::run_time(double source_time) {
+  if (!first_time_) first_time_ = source_time;
+  return static_cast<double>(std::llround((source_time - *first_time_) * 1e6)) / 1e6;
+}
+
 void CarPipeline::on_frame(const can::Frame& frame) {
   samples_.clear();
   if (mapper_.map(frame, samples_) == FrameOutcome::BadTime) return;  // not a time the grid can hold
-  for (const auto& s : samples_) resampler_.push(s.channel, s.time, s.value);
+  const double t = run_time(frame.timestamp);
+  for (const auto& s : samples_) resampler_.push(s.channel, t, s.value);
   // Every frame moves the clock, so a silent channel is declared stale in time.
-  resampler_.advance_clock(frame.timestamp);
+  resampler_.advance_clock(t);
+}
+
+void CarPipeline::idle(double time) {
+  if (first_time_) resampler_.idle(run_time(time));
 }
 
 void CarPipeline::finish() {

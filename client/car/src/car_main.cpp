@@ -1,4 +1,5 @@
-// dynid-car: the car-side client. Reads the CAN bus (SocketCAN) or replays a candump log,
+// dynid-car: the car-side client. Reads the CAN bus (SocketCAN) or replays a CAN log (candump,
+// Vector ASC or BLF: can/log_reader.hpp),
 // decodes it with the vehicle profile, cuts chunks, keeps them in the spool and delivers them to
 // the server until it acknowledges them durably (delivery.hpp).
 //
@@ -43,7 +44,7 @@
 #include <dynid/error.hpp>
 #include <dynid/input/option_checks.hpp>
 
-#include "dynid/car/candump_source.hpp"
+#include "dynid/car/log_source.hpp"
 #include "dynid/car/chunk_file.hpp"
 #include "dynid/car/delivery.hpp"
 #include "dynid/car/pipeline.hpp"
@@ -136,7 +137,7 @@ double at_log_resolution(double seconds) {
 constexpr std::uint64_t kProbeLines = 10000;
 
 // "<file>: <reason>", with the first bad line's reason when there is one.
-std::string log_problem(const Options& options, const CandumpSource& source, const std::string& problem) {
+std::string log_problem(const Options& options, const LogSource& source, const std::string& problem) {
   const auto errors = source.errors();
   return options.replay + ": not a CAN log this profile can use: " + problem +
          (errors.empty() ? "" : "; first: " + errors.front());
@@ -144,7 +145,7 @@ std::string log_problem(const Options& options, const CandumpSource& source, con
 
 // A file the replay would make nothing of fails here, before any state changes.
 void probe_log(const Options& options, const VehicleProfile& profile) {
-  CandumpSource source(options.replay, kProbeLines);
+  LogSource source(options.replay, kProbeLines);
   const std::string problem = replay_problem(probe(source, profile, kProbeLines));
   if (!problem.empty())
     throw dynid::InputError(log_problem(options, source, problem + " in its first " + std::to_string(kProbeLines) +
@@ -155,7 +156,7 @@ void probe_log(const Options& options, const VehicleProfile& profile) {
 // Returns replay_problem() of the whole log as "<file>: <reason>", or "".
 std::string replay_log(const Options& options, CarPipeline& pipe,
                        std::function<void(const ReplayProgress&)> on_progress) {
-  CandumpSource source(options.replay);
+  LogSource source(options.replay);
   ReplayOptions ro;
   ro.speed = options.fast ? 0.0 : options.speed;
   ro.progress_interval = 100ms;  // also how often acknowledgements are taken while replaying
@@ -390,7 +391,7 @@ int main(int argc, char** argv) {
                  "Cyclone DDS configuration: a file (deploy/cyclonedds/*.xml), or file:// URIs and XML "
                  "fragments, comma-separated, as in CYCLONEDDS_URI (required unless --chunks-out)");
   app.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 230));
-  auto* replay_opt = app.add_option("--replay", o.replay, "replay this candump -l log")->check(input::input_file("CAN log"));
+  auto* replay_opt = app.add_option("--replay", o.replay, "replay this CAN log (candump -l, Vector ASC or BLF, told by its content)")->check(input::input_file("CAN log"));
   auto* can_opt = app.add_option("--can", o.can, "read this SocketCAN interface live (e.g. can0)");
   replay_opt->excludes(can_opt);
   auto* speed_opt = app.add_option("--speed", o.speed, "replay speed (1 = real time)")

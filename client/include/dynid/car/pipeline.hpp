@@ -6,10 +6,15 @@
 //
 // Contract: on_frame() never throws for bad frames (they are counted in mapper_stats()). The
 // clock of the grid is the frames' timestamps, cut into pieces where it jumps (no row is made up
-// for the time of a jump: resampler.hpp, Time jumps); idle() lets a live loop that timed out push the
+// for the time of a jump: resampler.hpp, Time jumps), taken as the time since the run's first
+// frame (of usable time) in whole microseconds: the chunks depend on the times between frames,
+// not on where the log's clock starts nor on the format's resolution past a microsecond, so a
+// candump, an ASC and a BLF log of the same frames cut the same chunks, bit for bit (a format may
+// hold the measurement start only to the millisecond, or none before 1990: can/blf.hpp); idle() lets a live loop that timed out push the
 // clock forward so rows still leave within the latency bound. finish() emits the last rows and
 // the final partial chunk; nothing may be fed after it. The profile must outlive the pipeline.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,7 +33,7 @@ class CarPipeline {
   void on_frame(const can::Frame& frame);
   /// Advances the grid clock to `time` (source clock) without a frame; a silence longer than
   /// the profile's max_time_jump ends the grid piece (resampler.hpp, Time jumps).
-  void idle(double time) { resampler_.idle(time); }
+  void idle(double time);
   void finish();
 
   const MapStats& mapper_stats() const { return mapper_.stats(); }
@@ -37,7 +42,9 @@ class CarPipeline {
   /// Where the frames' clock jumps (the profile's max_time_jump; the resampler's latency back).
   TimeJumpLimits time_jumps() const { return time_jumps_; }
   /// Source-clock time of grid index 0 (valid once the first sample arrived).
-  double origin() const { return resampler_.origin(); }
+  double origin() const { return first_time_.value_or(0.0) + resampler_.origin(); }
+  /// Source-clock time of the run's first frame (the grid's clock counts from it), if any yet.
+  std::optional<double> first_time() const { return first_time_; }
 
  private:
   TimeJumpLimits time_jumps_;
@@ -45,6 +52,9 @@ class CarPipeline {
   ChunkBuilder builder_;
   Resampler resampler_;
   std::vector<ChannelSample> samples_;
+  std::optional<double> first_time_;
+
+  double run_time(double source_time);
 };
 
 }  // namespace dynid::car
