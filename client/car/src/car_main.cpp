@@ -38,12 +38,15 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <map>
 #include <string>
+#include <vector>
 
 #include <dynid/dds/participant.hpp>
 #include <dynid/error.hpp>
 #include <dynid/input/option_checks.hpp>
 
+#include "dynid/car/auxiliary.hpp"
 #include "dynid/car/log_source.hpp"
 #include "dynid/car/chunk_file.hpp"
 #include "dynid/car/delivery.hpp"
@@ -75,6 +78,7 @@ struct Options {
   double ack_timeout = 5.0;
   std::string chunks_out;
   std::uint64_t max_frames = 0;  // live: stop after this many frames (0: only on a signal)
+  std::vector<std::string> sources;  // --source NAME=FILE
 };
 
 constexpr const char* kLogPattern = "dynid-car %l: %v";
@@ -132,6 +136,36 @@ double at_log_resolution(double seconds) {
   return static_cast<double>(std::llround(seconds * 1e6)) / 1e6;
 }
 
+// The profile of this run: the declared one with the auxiliary sources given (auxiliary.hpp),
+// their clocks put on the bus's (an estimate reads the replayed log once), reported.
+RunSources run_profile(const Options& options) {
+  const VehicleProfile declared = load_vehicle_profile(options.profile);
+  std::map<std::string, std::filesystem::path> given;
+  for (const auto& s : options.sources) {
+    const std::size_t eq = s.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == s.size())
+      throw dynid::InputError("--source '" + dynid::input::printable(s) + "': expected NAME=FILE");
+    if (!given.emplace(s.substr(0, eq), s.substr(eq + 1)).second)
+      throw dynid::InputError("--source " + dynid::input::printable(s.substr(0, eq)) + " given twice");
+  }
+  std::optional<LogSource> bus;
+  if (!options.replay.empty()) bus.emplace(options.replay);
+  RunSources run = prepare_sources(declared, given, bus ? &*bus : nullptr);
+  for (const auto& r : run.reports) {
+    spdlog::info("{}", r.describe());
+    for (const auto& w : r.warnings) spdlog::warn("source '{}': {}", r.name, w);
+  }
+  return run;
+}
+
+// The auxiliary samples into the pipeline; what was merged is logged at the end.
+void log_auxiliary(const CarPipeline& pipe) {
+  const AuxiliaryStats& a = pipe.auxiliary_stats();
+  if (a.merged + a.before_bus + a.after_bus == 0) return;
+  spdlog::info("auxiliary sources: {} samples merged into the grid, {} before the first frame and {} after the last "
+               "dropped", a.merged, a.before_bus, a.after_bus);
+}
+
 // Lines of a log judged before anything of it is announced, spooled or written: enough to tell
 // a log from another file at once, few enough that the probe costs nothing (about 5 ms).
 constexpr std::uint64_t kProbeLines = 10000;
@@ -162,6 +196,9 @@ std::string replay_log(const Options& options, CarPipeline& pipe,
   ro.progress_interval = 100ms;  // also how often acknowledgements are taken while replaying
   ro.on_progress = std::move(on_progress);
   const ReplayProgress done = replay(source, pipe, ro);
+  log_auxiliary(pipe);
+  if (done.rows > 0)  // where the run's times (row / rate) sit on the log's clock, e.g. to compare with its GNSS
+    spdlog::info("grid row 0 is at {:.6f} s of the log's clock", pipe.origin());
   spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids, {} timestamps out of range), {:.1f} s of "
                "log, {} jumps of its clock, {} chunks",
                done.frames, source.bad_input(), done.unknown_id, pipe.mapper_stats().bad_time, done.log_seconds,
@@ -209,6 +246,7 @@ void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe
 struct Session {
   const Options& options;
   const VehicleProfile& profile;
+  std::vector<AuxiliarySample> auxiliary;  // into the run's one pipeline
   Spool& spool;
   Delivery& delivery;
   ProgressDisplay& display;
@@ -228,10 +266,12 @@ struct Session {
 
   // The sink of the pipeline: spool, then send. SpoolFull propagates and stops the reading.
   CarPipeline pipeline(const std::string& run) {
-    return CarPipeline(profile, run, [this](dynid::ingest::Chunk&& chunk) {
+    CarPipeline pipe(profile, run, [this](dynid::ingest::Chunk&& chunk) {
       delivery.submit(chunk);
       if (g_stop.load()) throw Interrupted{};
     });
+    pipe.add_auxiliary(std::move(auxiliary));
+    return pipe;
   }
 
   void replay_run(const std::string& run) {
@@ -307,7 +347,8 @@ struct Session {
 
 // --chunks-out: the same reading and pipeline, the chunks written to a file instead of delivered.
 int write_chunks(const Options& options) {
-  const VehicleProfile profile = load_vehicle_profile(options.profile);
+  RunSources sources = run_profile(options);
+  const VehicleProfile& profile = sources.profile;
   if (!options.replay.empty()) probe_log(options, profile);
   // The source is opened before the chunk file is created: a bus that cannot be read leaves none.
   std::optional<SocketCanSource> live;
@@ -315,6 +356,7 @@ int write_chunks(const Options& options) {
   const std::string run = options.run.empty() ? default_run_id() : options.run;
   ChunkFileWriter writer(options.chunks_out);
   CarPipeline pipe(profile, run, [&writer](dynid::ingest::Chunk&& chunk) { writer.write(chunk); });
+  pipe.add_auxiliary(std::move(sources.samples));
   spdlog::info("run {}/{}: {} channels at {} Hz, {} rows per chunk, chunks to {}", profile.vehicle, run,
                profile.channels.size(), profile.rate_hz, profile.chunk_rows, options.chunks_out);
   std::string problem;
@@ -342,7 +384,8 @@ int write_chunks(const Options& options) {
 int run(const Options& options, ProgressDisplay& display) {
   // Every input is checked before the spool is touched.
   const std::string cyclone_config = dynid::dds::config_uri(options.cyclone_config);
-  const VehicleProfile profile = load_vehicle_profile(options.profile);
+  RunSources sources = run_profile(options);
+  const VehicleProfile& profile = sources.profile;
   if (!options.replay.empty()) probe_log(options, profile);
   const std::filesystem::path spool_dir = options.spool.empty() ? profile.spool_directory : std::filesystem::path(options.spool);
   Spool spool(spool_dir, profile.spool_max_bytes);
@@ -359,7 +402,7 @@ int run(const Options& options, ProgressDisplay& display) {
   });
 
 
-  Session session{options, profile, spool, delivery, display};
+  Session session{options, profile, std::move(sources.samples), spool, delivery, display};
   if (!options.replay.empty() || !options.can.empty()) session.read_source();
   const bool drained = session.drain();
   const auto& s = delivery.stats();
@@ -401,6 +444,9 @@ int main(int argc, char** argv) {
                  "no server: write the run's chunks to this file (length-prefixed "
                  "encode_chunk records) and exit")
       ->check(input::output_file("chunk file"));
+  app.add_option("--source", o.sources,
+                 "NAME=FILE: the file of the profile's auxiliary source NAME for this run (repeatable; "
+                 "overrides the profile's file)");
   app.add_option("--max-frames", o.max_frames, "live: stop after this many frames")
       ->check(input::within(1, kMaxFrames))->needs(can_opt);
   app.add_option("--spool", o.spool, "spool folder (default: the profile's [spool] directory)");

@@ -36,6 +36,21 @@
 //   # divide_by (a number or the name of a [constants] entry, e.g. "steering_ratio"),
 //   # sign = -1, max_gap (seconds, at most 3600, instead of the derived window).
 //
+//   [[sources]]                        # optional: auxiliary sources besides the bus (auxiliary.hpp)
+//   name = "recorder_imu"              # the id rule (input/ids.hpp); dynid-car --source NAME=FILE
+//   type = "csv"                       # a time-stamped CSV file, one header line
+//   file = "imu.csv"                   # optional, relative to this profile; --source overrides
+//   time_column = "t"
+//   time_unit = "s"                    # s, ms, us or ns
+//   clock = { offset = 0.0 }           # bus time = source time + offset (seconds), or
+//   clock = { estimate_from = "ax", reference = "ax", max_offset = 2.0, reference_derivative = false }
+//   [[sources.channels]]
+//   column = "ax"                      # a column of the header
+//   channel = "ax"                     # catalogue channel
+//   unit = "m/s^2"                     # required: the column's unit, converted to the channel's
+//   # optional: scale, sign = -1, max_gap (as for bus channels), replaces_bus = true (the bus
+//   # mapping of this channel gives way when the source is given for a run)
+//
 // Value of a channel sample: sign * scale / divide_by * combine_i(conv_i(dbc_value_i)), where
 // conv_i converts signal i from its DBC unit to the channel's SI unit. All signals of a channel
 // come from one message, so they share a timestamp and combining them needs no resampling.
@@ -84,10 +99,45 @@ struct ChannelMapping {
   Combine combine = Combine::Sum;
   double gain = 1.0;    ///< sign * scale / divide_by
   std::optional<double> max_gap;  ///< seconds; unset: derived from the signal's period
+  /// Set for a channel of an auxiliary source (with_sources()): index into
+  /// VehicleProfile::sources and into its channels; the bus decoder never sees it.
+  std::optional<std::size_t> source;
+  std::size_t source_channel = 0;
 
   /// The channel value from the message's decoded physical values (indexed like
   /// can::Message::signals).
   double value(const std::vector<double>& physical_by_signal) const;
+};
+
+/// One column of an auxiliary source mapped to a catalogue channel.
+struct SourceChannel {
+  std::string column;
+  std::string channel;
+  std::string unit;            ///< the catalogue's SI unit
+  std::string given_unit;      ///< the column's unit as the profile gives it
+  LinearConversion to_si;
+  double gain = 1.0;           ///< sign * scale
+  std::optional<double> max_gap;
+  bool replaces_bus = false;
+};
+
+/// How a source's clock relates to the bus: bus time = source time + offset.
+struct SourceClockRelation {
+  std::optional<double> offset;   ///< fixed; else estimated:
+  std::string estimate_from;      ///< a channel of this source
+  std::string reference;          ///< a bus channel of the profile ([[channels]])
+  bool reference_derivative = false;  ///< compare with d(reference)/dt (speed against acceleration)
+  double max_offset = 2.0;        ///< seconds searched either way
+};
+
+struct AuxiliarySourceSpec {
+  std::string name;
+  std::string type;               ///< "csv"
+  std::filesystem::path file;     ///< empty: given per run (--source NAME=FILE)
+  std::string time_column;
+  double time_scale = 1.0;        ///< source time unit -> seconds
+  SourceClockRelation clock;
+  std::vector<SourceChannel> channels;
 };
 
 struct VehicleProfile {
@@ -101,6 +151,9 @@ struct VehicleProfile {
   double max_gap_periods = 2.5;
   double max_time_jump = 10.0;  ///< seconds (TimeJumpLimits::forward)
   std::vector<ChannelMapping> channels;  ///< the column order of every chunk
+  /// Declared auxiliary sources; their channels join `channels` only for a run that gives them
+  /// (with_sources(), auxiliary.hpp): a profile as loaded maps the bus alone.
+  std::vector<AuxiliarySourceSpec> sources;
   model::Constants constants;
   std::vector<ingest::ModelSpec> models;
   std::filesystem::path spool_directory;
