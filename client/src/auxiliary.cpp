@@ -10,6 +10,7 @@
 #include <dynid/input/input_file.hpp>
 #include <dynid/input/number.hpp>
 
+#include "dynid/car/log_source.hpp"
 #include "dynid/car/signal_mapper.hpp"
 #include "dynid/error.hpp"
 
@@ -178,6 +179,56 @@ ChannelMapping source_mapping(const AuxiliarySourceSpec& spec, std::size_t si, s
 
 }  // namespace
 
+namespace {
+
+// The source's channels as series on its own clock, in SI: a CSV file's columns, or the
+// channels a second bus's log gives through its DBC.
+std::vector<TimeSeries> read_source(const AuxiliarySourceSpec& spec, SourceReport& report) {
+  std::vector<TimeSeries> series(spec.channels.size());
+  if (spec.type == "csv") {
+    const AuxiliaryTable table = read_auxiliary_csv(spec, report.file);
+    report.warnings = table.warnings;
+    report.unmapped_columns = table.unmapped_columns;
+    for (std::size_t ci = 0; ci < spec.channels.size(); ++ci)
+      for (std::size_t i = 0; i < table.time.size(); ++i) {
+        const double v = table.values[ci][i];
+        if (!std::isfinite(v)) continue;
+        series[ci].t.push_back(table.time[i]);
+        series[ci].v.push_back(spec.channels[ci].gain * spec.channels[ci].to_si.apply(v));
+      }
+    return series;
+  }
+  LogSource log(report.file);
+  SignalMapper mapper(*spec.bus);
+  std::vector<ChannelSample> samples;
+  can::Frame frame;
+  std::uint64_t out_of_order = 0;
+  while (log.next(frame, std::chrono::milliseconds(0)) == NextStatus::Frame) {
+    samples.clear();
+    mapper.map(frame, samples);
+    for (const auto& x : samples) {
+      TimeSeries& ts = series[x.channel];
+      if (!ts.t.empty() && !(x.time > ts.t.back())) {
+        ++out_of_order;
+        continue;
+      }
+      ts.t.push_back(x.time);
+      ts.v.push_back(x.value);
+    }
+  }
+  if (mapper.stats().mapped == 0)
+    throw InputError(report.file.string() + ": source '" + spec.name + "': none of its " +
+                     std::to_string(mapper.stats().frames) + " frames gives a channel of the source (" +
+                     std::to_string(log.bad_input()) + " bad lines or objects)");
+  if (log.bad_input() > 0)
+    report.warnings.push_back(std::to_string(log.bad_input()) + " bad lines or objects skipped; first: " + log.errors().front());
+  if (out_of_order > 0)
+    report.warnings.push_back(std::to_string(out_of_order) + " samples not after their channel's previous one dropped");
+  return series;
+}
+
+}  // namespace
+
 RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::string, std::filesystem::path>& given,
                            FrameSource* bus) {
   for (const auto& [name, path] : given) {
@@ -190,7 +241,7 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
                        "' (declared: " + (names.empty() ? "none" : names) + ")");
   }
   RunSources run{declared, {}, {}};
-  std::vector<AuxiliaryTable> tables(declared.sources.size());
+  std::vector<std::vector<TimeSeries>> series(declared.sources.size());
   std::set<std::size_t> wanted;
   for (std::size_t si = 0; si < declared.sources.size(); ++si) {
     const AuxiliarySourceSpec& spec = declared.sources[si];
@@ -199,9 +250,7 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
     const auto it = given.find(spec.name);
     report.file = it != given.end() ? it->second : spec.file;
     if (!report.file.empty()) {
-      tables[si] = read_auxiliary_csv(spec, report.file);
-      report.warnings = tables[si].warnings;
-      report.unmapped_columns = tables[si].unmapped_columns;
+      series[si] = read_source(spec, report);
       if (spec.clock.offset) {
         report.offset = *spec.clock.offset;
       } else {
@@ -225,20 +274,17 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
     const AuxiliarySourceSpec& spec = declared.sources[si];
     SourceReport& report = run.reports[si];
     if (report.file.empty()) continue;
-    const AuxiliaryTable& table = tables[si];
     if (!spec.clock.offset) {
       std::size_t from = 0;
       while (spec.channels[from].channel != spec.clock.estimate_from) ++from;
-      TimeSeries source;
-      for (std::size_t i = 0; i < table.time.size(); ++i)
-        if (std::isfinite(table.values[from][i])) source.t.push_back(table.time[i]), source.v.push_back(table.values[from][i]);
       ClockOffsetOptions o;
       o.max_offset = spec.clock.max_offset;
       o.reference_derivative = spec.clock.reference_derivative;
       const std::string what = "source '" + spec.name + "' (" + report.file.string() + "): clock from " +
                                spec.clock.estimate_from + " against the bus's " + spec.clock.reference +
                                (o.reference_derivative ? " (its derivative)" : "");
-      const ClockEstimate e = estimate_clock_offset(reference[bus_channel(declared, spec.clock.reference)], source, o, what);
+      const ClockEstimate e =
+          estimate_clock_offset(reference[bus_channel(declared, spec.clock.reference)], series[si][from], o, what);
       if (e.drifting())
         throw InputError(what + ": the clock drifts: offset " + fmt(e.start) + " +- " + fmt(e.start_std).substr(1) +
                          " s over the first half, " + fmt(e.end) + " +- " + fmt(e.end_std).substr(1) +
@@ -250,12 +296,9 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
     std::vector<std::size_t> column_of(spec.channels.size());
     for (std::size_t c = 0; c < run.profile.channels.size(); ++c)
       if (run.profile.channels[c].source == si) column_of[run.profile.channels[c].source_channel] = c;
-    for (std::size_t i = 0; i < table.time.size(); ++i)
-      for (std::size_t ci = 0; ci < spec.channels.size(); ++ci) {
-        const double v = table.values[ci][i];
-        if (!std::isfinite(v)) continue;
-        const SourceChannel& c = spec.channels[ci];
-        run.samples.push_back({table.time[i] + report.offset, column_of[ci], c.gain * c.to_si.apply(v)});
+    for (std::size_t ci = 0; ci < spec.channels.size(); ++ci)
+      for (std::size_t i = 0; i < series[si][ci].t.size(); ++i) {
+        run.samples.push_back({series[si][ci].t[i] + report.offset, column_of[ci], series[si][ci].v[i]});
         ++report.samples;
       }
   }

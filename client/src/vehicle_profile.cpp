@@ -109,20 +109,24 @@ class Reader {
   std::filesystem::path source_;
 };
 
+// The DBC and interfaces of a bus: [vehicle], or a type = "can" source (`prefix` its key).
+void read_bus(const Reader& r, const toml::table& v, const std::string& prefix, VehicleProfile& p) {
+  p.dbc_path = r.relative_path(r.string(v, "dbc", prefix + "dbc"));
+  try {
+    p.dbc = std::make_shared<const can::Database>(can::parse_dbc_file(p.dbc_path));
+  } catch (const std::exception& e) {
+    r.fail(prefix + "dbc", "cannot read the DBC '" + p.dbc_path.string() + "': " + e.what(), v.get("dbc"));
+  }
+  if (const toml::node* n = v.get("interfaces")) p.interfaces = r.strings(*n, prefix + "interfaces");
+}
+
 void read_vehicle(const Reader& r, const toml::table& root, VehicleProfile& p) {
   const toml::table& v = r.table(root, "vehicle");
   r.only_keys(v, {"id", "dbc", "interfaces"}, "vehicle.");
   p.vehicle = r.string(v, "id", "vehicle.id");
   if (const std::string problem = input::id_problem(p.vehicle); !problem.empty())
     r.fail("vehicle.id", "'" + input::printable(p.vehicle) + "' " + problem, v.get("id"));
-  p.dbc_path = r.relative_path(r.string(v, "dbc", "vehicle.dbc"));
-  try {
-    p.dbc = std::make_shared<const can::Database>(can::parse_dbc_file(p.dbc_path));
-  } catch (const std::exception& e) {
-    r.fail("vehicle.dbc", "cannot read the DBC '" + p.dbc_path.string() + "': " + e.what(),
-           v.get("dbc"));
-  }
-  if (const toml::node* n = v.get("interfaces")) p.interfaces = r.strings(*n, "vehicle.interfaces");
+  read_bus(r, v, "vehicle.", p);
 }
 
 void read_grid(const Reader& r, const toml::table& root, VehicleProfile& p) {
@@ -265,10 +269,15 @@ double read_sign(const Reader& r, const toml::table& t, const std::string& key) 
 }
 
 ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml::table& t,
-                            const std::string& key) {
-  r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
-                  "scale", "divide_by", "sign", "max_gap"},
-              key + ".");
+                            const std::string& key, bool in_source = false) {
+  if (in_source)  // a channel of a second bus (type = "can" source)
+    r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
+                    "scale", "divide_by", "sign", "max_gap", "replaces_bus"},
+                key + ".");
+  else
+    r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
+                    "scale", "divide_by", "sign", "max_gap"},
+                key + ".");
   ChannelMapping m;
   m.channel = r.string(t, "name", key + ".name");
   const auto unit = model::channel_unit(m.channel);
@@ -381,22 +390,35 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
   for (std::size_t i = 0; i < a->size(); ++i) {
     const std::string key = "sources[" + std::to_string(i) + "]";
     const toml::table& t = *a->get(i)->as_table();
-    r.only_keys(t, {"name", "type", "file", "time_column", "time_unit", "clock", "channels"}, key + ".");
     AuxiliarySourceSpec s;
+    s.type = r.string(t, "type", key + ".type");
+    if (s.type != "csv" && s.type != "can")
+      r.fail(key + ".type", "unknown source type '" + s.type + "' (\"csv\" or \"can\")", t.get("type"));
+    if (s.type == "csv")
+      r.only_keys(t, {"name", "type", "file", "time_column", "time_unit", "clock", "channels"}, key + ".");
+    else
+      r.only_keys(t, {"name", "type", "file", "dbc", "interfaces", "clock", "channels"}, key + ".");
     s.name = r.string(t, "name", key + ".name");
     if (const std::string problem = input::id_problem(s.name); !problem.empty())
       r.fail(key + ".name", "'" + input::printable(s.name) + "' " + problem, t.get("name"));
     if (!names.insert(s.name).second) r.fail(key + ".name", "duplicate source '" + s.name + "'", t.get("name"));
-    s.type = r.string(t, "type", key + ".type");
-    if (s.type != "csv") r.fail(key + ".type", "unknown source type '" + s.type + "' (\"csv\")", t.get("type"));
     if (t.contains("file")) s.file = r.relative_path(r.string(t, "file", key + ".file"));
-    s.time_column = r.string(t, "time_column", key + ".time_column");
-    const std::string unit = r.string(t, "time_unit", key + ".time_unit");
-    if (unit == "s") s.time_scale = 1.0;
-    else if (unit == "ms") s.time_scale = 1e-3;
-    else if (unit == "us") s.time_scale = 1e-6;
-    else if (unit == "ns") s.time_scale = 1e-9;
-    else r.fail(key + ".time_unit", "expected \"s\", \"ms\", \"us\" or \"ns\"", t.get("time_unit"));
+    std::shared_ptr<VehicleProfile> bus;
+    if (s.type == "csv") {
+      s.time_column = r.string(t, "time_column", key + ".time_column");
+      const std::string unit = r.string(t, "time_unit", key + ".time_unit");
+      if (unit == "s") s.time_scale = 1.0;
+      else if (unit == "ms") s.time_scale = 1e-3;
+      else if (unit == "us") s.time_scale = 1e-6;
+      else if (unit == "ns") s.time_scale = 1e-9;
+      else r.fail(key + ".time_unit", "expected \"s\", \"ms\", \"us\" or \"ns\"", t.get("time_unit"));
+    } else {
+      bus = std::make_shared<VehicleProfile>();
+      bus->source = p.source;
+      bus->vehicle = p.vehicle;
+      bus->constants = p.constants;
+      read_bus(r, t, key + ".", *bus);
+    }
     s.clock = read_clock(r, t, key);
     const toml::node* cn = t.get("channels");
     const toml::array* ca = cn == nullptr ? nullptr : cn->as_array();
@@ -405,7 +427,18 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
     for (std::size_t j = 0; j < ca->size(); ++j) {
       const std::string ckey = key + ".channels[" + std::to_string(j) + "]";
       const toml::table& ct = *ca->get(j)->as_table();
-      SourceChannel c = read_source_channel(r, p, ct, ckey);
+      SourceChannel c;
+      if (bus) {  // a mapping of the second bus, as [[channels]]
+        ChannelMapping m = read_channel(r, *bus, ct, ckey, true);
+        c.column = m.message;
+        c.channel = m.channel;
+        c.unit = m.unit;
+        c.max_gap = m.max_gap;
+        c.replaces_bus = read_bool(r, ct, "replaces_bus", ckey);
+        bus->channels.push_back(std::move(m));
+      } else {
+        c = read_source_channel(r, p, ct, ckey);
+      }
       if (!channels.insert(c.channel).second)
         r.fail(ckey + ".channel", "channel '" + c.channel + "' comes from two sources", ct.get("channel"));
       bool on_bus = false;
@@ -418,13 +451,14 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
         r.fail(ckey + ".replaces_bus", "no bus channel '" + c.channel + "' to replace", ct.get("replaces_bus"));
       s.channels.push_back(std::move(c));
     }
+    s.bus = bus;
     if (!s.clock.offset) {
       bool mine = false;
       for (const auto& c : s.channels) mine = mine || c.channel == s.clock.estimate_from;
       if (!mine) r.fail(key + ".clock.estimate_from", "'" + s.clock.estimate_from + "' is not a channel of this source");
-      bool bus = false;
-      for (const auto& m : p.channels) bus = bus || m.channel == s.clock.reference;
-      if (!bus) r.fail(key + ".clock.reference", "'" + s.clock.reference + "' is not a bus channel ([[channels]])");
+      bool known = false;
+      for (const auto& m : p.channels) known = known || m.channel == s.clock.reference;
+      if (!known) r.fail(key + ".clock.reference", "'" + s.clock.reference + "' is not a bus channel ([[channels]])");
     }
     p.sources.push_back(std::move(s));
   }

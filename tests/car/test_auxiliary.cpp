@@ -10,6 +10,8 @@
 #include <random>
 #include <sstream>
 
+#include <dynid/can/candump.hpp>
+#include <dynid/can/encoder.hpp>
 #include <dynid/error.hpp>
 
 #include "car_test_support.hpp"
@@ -121,6 +123,45 @@ TEST(CarAuxiliary, MergedOntoTheGridInSiUnitsOnTheBusClock) {
   EXPECT_GT(valid, 750u);
 }
 
+TEST(CarAuxiliary, ASecondBusLogWithItsOwnDbcIsASource) {
+  const VehicleProfile declared = profile(
+      "[[sources]]\nname = \"chassis\"\ntype = \"can\"\ndbc = \"" + kDbc + "\"\ninterfaces = [\"can1\"]\n"
+      "clock = { offset = 0.25 }\n[[sources.channels]]\nname = \"yaw_rate\"\nmessage = \"ESP_Dynamics\"\n"
+      "signal = \"YawRate\"\n");
+  test::ScratchDir dir("aux-can");
+  const auto log = dir.path() / "chassis.log";
+  {
+    std::ofstream out(log);
+    can::CandumpWriter writer(out);
+    const can::Message& m = *declared.sources.at(0).bus->dbc->find_message("ESP_Dynamics");
+    for (int i = 0; i <= 1000; ++i) {
+      can::Frame f;
+      const can::SignalValue yaw{"YawRate", 57.3};
+      ASSERT_TRUE(can::encode_frame(m, std::span(&yaw, 1), f).ok());
+      f.timestamp = i * 0.01;
+      f.set_interface_name(i % 2 ? "can1" : "can7");  // can7: not this source's bus
+      writer.write(f);
+    }
+  }
+  const RunSources run = prepare_sources(declared, {{"chassis", log}}, nullptr);
+  ASSERT_EQ(run.profile.channels.size(), 3u);
+  EXPECT_EQ(run.profile.channels[2].channel, "yaw_rate");
+  EXPECT_EQ(run.reports.at(0).samples, 500u);  // the can1 frames only
+  const auto chunks = run_pipeline(run);
+  std::size_t valid = 0;
+  for (const auto& c : chunks)
+    for (Eigen::Index k = 0; k < c.samples.rows(); ++k)
+      if (c.valid[static_cast<std::size_t>(k)]) {
+        ++valid;
+        EXPECT_NEAR(c.samples(k, 2), 57.3 * std::numbers::pi / 180.0, 1e-12);
+      }
+  EXPECT_GT(valid, 750u);
+  EXPECT_HAS(error_of([&] { (void)profile("[[sources]]\nname = \"c\"\ntype = \"can\"\ndbc = \"" + kDbc +
+                                          "\"\nclock = { offset = 0.0 }\n[[sources.channels]]\nname = \"yaw_rate\"\n"
+                                          "message = \"NoSuchMessage\"\nsignal = \"X\"\n"); }),
+             "sources[0].channels[0].message: unknown DBC message 'NoSuchMessage'");
+}
+
 TEST(CarAuxiliary, AGapInTheSourceIsAGapOfItsChannelAsOnTheBus) {
   test::ScratchDir dir("aux-gap");
   // No logger rows from 4 to 5 s of its clock: 4.5 .. 5.5 s on the bus.
@@ -182,7 +223,7 @@ TEST(CarAuxiliary, BadSourceDeclarationsAreNamed) {
              "sources[0].clock.reference: 'yaw_rate' is not a bus channel");
   EXPECT_HAS(declared(head + "clock = { offset = 0.0 }\ncolumns = 3\n[[sources.channels]]\ncolumn = \"a\"\nchannel = \"az\"\nunit = \"g\"\n"),
              "sources[0].columns: unknown key");
-  EXPECT_HAS(declared("[[sources]]\nname = \"../x\"\n"), "sources[0].name: '../x'");
+  EXPECT_HAS(declared("[[sources]]\ntype = \"csv\"\nname = \"../x\"\n"), "sources[0].name: '../x'");
   // Estimated clocks need the replayed log.
   const VehicleProfile estimated = profile(head + "clock = { estimate_from = \"az\", reference = \"ax\" }\n"
                                                   "[[sources.channels]]\ncolumn = \"a\"\nchannel = \"az\"\nunit = \"g\"\n");

@@ -50,6 +50,17 @@
 //   unit = "m/s^2"                     # required: the column's unit, converted to the channel's
 //   # optional: scale, sign = -1, max_gap (as for bus channels), replaces_bus = true (the bus
 //   # mapping of this channel gives way when the source is given for a run)
+//   [[sources]]                        # a second CAN log (candump, ASC, BLF) with its own DBC
+//   name = "chassis"
+//   type = "can"
+//   dbc = "chassis.dbc"                # relative to this profile
+//   interfaces = ["can1"]              # optional, as [vehicle] interfaces
+//   file = "chassis.blf"               # optional; --source chassis=FILE
+//   clock = { offset = 0.0 }           # as above
+//   [[sources.channels]]               # written as [[channels]] are, plus replaces_bus
+//   name = "roll_rate"
+//   message = "IMU2"
+//   signal = "RollRate"
 //
 // Value of a channel sample: sign * scale / divide_by * combine_i(conv_i(dbc_value_i)), where
 // conv_i converts signal i from its DBC unit to the channel's SI unit. All signals of a channel
@@ -130,12 +141,17 @@ struct SourceClockRelation {
   double max_offset = 2.0;        ///< seconds searched either way
 };
 
+struct VehicleProfile;
+
 struct AuxiliarySourceSpec {
   std::string name;
-  std::string type;               ///< "csv"
+  std::string type;               ///< "csv" or "can"
   std::filesystem::path file;     ///< empty: given per run (--source NAME=FILE)
-  std::string time_column;
-  double time_scale = 1.0;        ///< source time unit -> seconds
+  std::string time_column;        ///< csv
+  double time_scale = 1.0;        ///< csv: source time unit -> seconds
+  /// can: a second bus's log with its own DBC: the DBC, interfaces and channel mappings (in
+  /// the order of `channels`), decoded as the main bus's are.
+  std::shared_ptr<const VehicleProfile> bus;
   SourceClockRelation clock;
   std::vector<SourceChannel> channels;
 };
