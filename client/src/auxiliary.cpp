@@ -39,6 +39,14 @@ std::string fmt(double v, int digits = 3) {
   return buf;
 }
 
+// "offset -0.215 +- 0.014 s at the start, -0.189 +- 0.014 s at the end (drift +0.00046 +- 0.00035 s/s)"
+std::string drift_text(const ClockEstimate& e) {
+  char drift[96];
+  std::snprintf(drift, sizeof drift, "drift %+.5f +- %.5f s/s", e.drift, e.drift_std);
+  return "offset " + fmt(e.start) + " +- " + fmt(e.start_std).substr(1) + " s at the start, " + fmt(e.end) + " +- " +
+         fmt(e.end_std).substr(1) + " s at the end (" + drift + ")";
+}
+
 }  // namespace
 
 AuxiliaryTable read_auxiliary_csv(const AuxiliarySourceSpec& spec, const std::filesystem::path& file) {
@@ -128,9 +136,7 @@ std::string SourceReport::describe() const {
   if (estimate)
     s += " +- " + fmt(estimate->std).substr(1) + " s (bus time = source time + offset; estimated, peak correlation " +
          fmt(estimate->correlation, 2).substr(1) + " at " + fmt(estimate->whole_run) + " s over the whole run, median of " +
-         std::to_string(estimate->pieces) + " pieces; first half " +
-         fmt(estimate->start) + " +- " + fmt(estimate->start_std).substr(1) + " s, second half " + fmt(estimate->end) +
-         " +- " + fmt(estimate->end_std).substr(1) + " s)";
+         std::to_string(estimate->pieces) + " pieces; " + drift_text(*estimate) + ")";
   else
     s += " (fixed in the profile)";
   return s;
@@ -286,9 +292,8 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
       const ClockEstimate e =
           estimate_clock_offset(reference[bus_channel(declared, spec.clock.reference)], series[si][from], o, what);
       if (e.drifting())
-        throw InputError(what + ": the clock drifts: offset " + fmt(e.start) + " +- " + fmt(e.start_std).substr(1) +
-                         " s over the first half, " + fmt(e.end) + " +- " + fmt(e.end_std).substr(1) +
-                         " s over the second: one offset cannot align it; put the source on the bus's clock first, "
+        throw InputError(what + ": the clock drifts: " + drift_text(e) +
+                         ": one offset cannot align it; put the source on the bus's clock first, "
                          "or give clock = { offset = ... } to accept it");
       report.estimate = e;
       report.offset = e.offset;

@@ -112,12 +112,17 @@ Spread robust(std::vector<double> x, double resolution) {
   return {m, std::max(1.4826 * median(dev) / std::sqrt(n), resolution / std::sqrt(12.0 * n))};
 }
 
+// Two-sided 1 % quantiles of Student's t (0.995) for 1..30 degrees of freedom.
+double t_quantile_99(std::size_t dof) {
+  static constexpr double kT[] = {63.657, 9.925, 5.841, 4.604, 4.032, 3.707, 3.499, 3.355, 3.250, 3.169,
+                                  3.106,  3.055, 3.012, 2.977, 2.947, 2.921, 2.898, 2.878, 2.861, 2.845,
+                                  2.831,  2.819, 2.807, 2.797, 2.787, 2.779, 2.771, 2.763, 2.756, 2.750};
+  return dof == 0 ? 1e300 : dof <= 30 ? kT[dof - 1] : 2.576;
+}
+
 }  // namespace
 
-bool ClockEstimate::drifting() const {
-  const double combined = std::hypot(start_std, end_std);
-  return std::abs(end - start) > 3.0 * combined && std::abs(end - start) > 0.02;
-}
+bool ClockEstimate::drifting() const { return drift_found; }
 
 ClockEstimate estimate_clock_offset(const TimeSeries& reference, const TimeSeries& source,
                                     const ClockOffsetOptions& o, const std::string& what) {
@@ -138,44 +143,50 @@ ClockEstimate estimate_clock_offset(const TimeSeries& reference, const TimeSerie
   ClockEstimate e;
   const Peak whole = best_lag(r, s, max_lag, 0, total);
   e.correlation = whole.r;
-  std::vector<double> first, second, all;
+  std::vector<double> all, centres;  // pieces that correlate: L and the piece's centre (s)
+  std::size_t first = 0, second = 0;
   for (int p = 0; p < o.segments; ++p) {
     const long a = total * p / o.segments, b = total * (p + 1) / o.segments;
     const Peak piece = best_lag(r, s, max_lag, a, b);
     if (piece.r < o.min_correlation) continue;
-    const double lag = piece.lag * o.step;
-    all.push_back(lag);
-    (2 * p < o.segments ? first : second).push_back(lag);
+    all.push_back(piece.lag * o.step);
+    centres.push_back(0.5 * static_cast<double>(a + b) * o.step);
+    ++(2 * p < o.segments ? first : second);
   }
-  if (first.size() < 2 || second.size() < 2)
-    throw InputError(what + ": too few parts of the run correlate (" + std::to_string(first.size()) + " of the first half, " +
-                     std::to_string(second.size()) + " of the second, at least 2 each with correlation >= " +
+  if (first < 2 || second < 2)
+    throw InputError(what + ": too few parts of the run correlate (" + std::to_string(first) + " of the first half, " +
+                     std::to_string(second) + " of the second, at least 2 each with correlation >= " +
                      std::to_string(o.min_correlation) + "; whole run " + std::to_string(whole.r) +
                      "): the quantity does not vary enough to estimate the clock offset; give clock = { offset = ... }");
-  // The scatter of a piece's L is judged on all pieces, each about its own half's median (a
-  // half's few pieces can agree by chance; a drift must not count as scatter).
   const Spread a = robust(all, o.step);
-  std::vector<double> deviations;
-  for (const auto* h : {&first, &second}) {
-    const double m = robust(*h, o.step).centre;
-    for (double x : *h) deviations.push_back(x - m);
-  }
-  double squares = 0.0;  // the sample sd (two medians fitted): few pieces make a MAD optimistic
-  for (double d : deviations) squares += d * d;
-  const double piece_sd = std::sqrt(squares / static_cast<double>(deviations.size() - 2));
-  const auto half = [&](const std::vector<double>& h) {
-    Spread spread = robust(h, o.step);
-    spread.std = std::max(spread.std, piece_sd / std::sqrt(static_cast<double>(h.size())));
-    return spread;
-  };
-  const Spread f = half(first), l = half(second);
-
   e.offset = a.centre;
   e.whole_run = whole.lag * o.step;
   e.std = a.std;
-  e.start = f.centre, e.start_std = f.std;
-  e.end = l.centre, e.end_std = l.std;
   e.pieces = static_cast<int>(all.size());
+
+  // Drift: the pieces' L against their time, a straight line by least squares; its slope tested
+  // against its standard error (t quantile of n - 2 degrees of freedom at 1 %, two-sided).
+  const auto m = static_cast<double>(all.size());
+  double cm = 0, lm = 0;
+  for (std::size_t i = 0; i < all.size(); ++i) cm += centres[i] / m, lm += all[i] / m;
+  double scc = 0, scl = 0;
+  for (std::size_t i = 0; i < all.size(); ++i) scc += (centres[i] - cm) * (centres[i] - cm), scl += (centres[i] - cm) * (all[i] - lm);
+  const double slope = scl / scc;
+  double sse = 0;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const double res = all[i] - lm - slope * (centres[i] - cm);
+    sse += res * res;
+  }
+  const double resolution = o.step / std::sqrt(12.0);  // a piece's L is no finer than its grid
+  const double piece_sd = std::max(std::sqrt(sse / (m - 2.0)), resolution);
+  const double slope_se = piece_sd / std::sqrt(scc);
+  const double span = centres.back() - centres.front();
+  e.start = lm + slope * (centres.front() - cm);
+  e.end = lm + slope * (centres.back() - cm);
+  e.start_std = e.end_std = piece_sd * std::sqrt(1.0 / m + (span / 2) * (span / 2) / scc);
+  e.drift = slope;
+  e.drift_std = slope_se;
+  e.drift_found = std::abs(slope) > t_quantile_99(all.size() - 2) * slope_se && std::abs(slope * span) > 2.0 * o.step;
   return e;
 }
 

@@ -266,7 +266,8 @@ TEST(CarAuxiliaryClock, ADriftingClockIsFound) {
   const TimeSeries bus = signal(0, 120, 83, 0, 1, 9, 0.05);
   const TimeSeries src = signal(10, 110, 104, 0.0, 1.004, 9, 0.2);  // 0.4 s over 100 s
   const ClockEstimate e = estimate_clock_offset(bus, src, {}, "test");
-  std::printf("first half %.3f +- %.3f s, second half %.3f +- %.3f s\n", e.start, e.start_std, e.end, e.end_std);
+  std::printf("start %.3f +- %.3f s, end %.3f +- %.3f s, drift %.5f +- %.5f s/s (true 0.004)\n", e.start, e.start_std,
+              e.end, e.end_std, e.drift, e.drift_std);
   EXPECT_TRUE(e.drifting());
 }
 

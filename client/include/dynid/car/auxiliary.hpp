@@ -18,7 +18,7 @@
 // (clock_offset.hpp) from a channel of the source against a bus channel decoded from the
 // replayed log (the bus mapping, even where the source replaces it in the run). A live run has
 // no log to estimate from before it starts: an estimated clock is then an error. A clock that
-// drifts (offsets of the first and second half disagreeing beyond their std) is an error: a fixed
+// drifts (a significant slope of the offset along the run, clock_offset.hpp) is an error: a fixed
 // offset cannot align it.
 #include <cstddef>
 #include <filesystem>

@@ -10,13 +10,13 @@
 // parabola through the peak: bus time = source time + L. The run is cut into `segments` (8)
 // equal pieces, L estimated on each; pieces whose peak correlation is below min_correlation
 // (0.3: no excitation there) are left out. The offset is the median of the pieces' L (the
-// whole overlap's peak, whole_run, is reported beside it: its strongest part dominates it). std is 1.4826 x the median absolute deviation of the
-// pieces' L over sqrt(pieces), at least the grid's resolution step / sqrt(12 pieces). The first
-// and the second half of the pieces give start and end offsets (their medians), each with the
-// std of a piece over sqrt(its pieces), a piece's std being the sample sd of all pieces about
-// their half's median (or the half's own robust std, if larger): drifting() is true when they
-// differ by more than 3 x their combined std and more than two grid steps (a fixed offset
-// cannot align such a clock).
+// whole overlap's peak, whole_run, is reported beside it: its strongest part dominates it). std is
+// 1.4826 x the median absolute deviation of the pieces' L over sqrt(pieces), at least the grid's
+// resolution step / sqrt(12 pieces). Drift: a straight line through the pieces' L against their
+// time (least squares); start and end are the line at the first and the last piece, with their
+// std; drifting() is true when its slope exceeds the 1 % two-sided t quantile (pieces - 2
+// degrees of freedom) times its standard error and the line moves by more than two grid steps
+// over the run: a fixed offset cannot align such a clock.
 //
 // Contract: estimate_clock_offset() throws InputError (naming `what`) when the series overlap
 // for less than 10 s plus twice max_offset, when fewer than 2 pieces of each half correlate, or
@@ -46,8 +46,10 @@ struct ClockEstimate {
   double whole_run = 0.0;    ///< the peak of the whole overlap (dominated by its strongest part)
   double std = 0.0;
   double correlation = 0.0;  ///< at the peak, whole overlap
-  double start = 0.0, start_std = 0.0;  ///< first half of the pieces
-  double end = 0.0, end_std = 0.0;      ///< second half
+  double start = 0.0, start_std = 0.0;  ///< the drift line at the first piece
+  double end = 0.0, end_std = 0.0;      ///< at the last piece
+  double drift = 0.0, drift_std = 0.0;  ///< slope of the pieces' offsets (s per s) and its std
+  bool drift_found = false;
   int pieces = 0;            ///< pieces that correlated
   bool drifting() const;
 };
