@@ -239,6 +239,7 @@ void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe
     }
   }
   pipe.finish();
+  log_auxiliary(pipe);
   spdlog::info("bus {} closed: {} frames, {} error frames, {} dropped by the kernel, {} chunks", options.can,
                source.frames(), source.error_frames(), source.dropped(), pipe.chunks());
 }

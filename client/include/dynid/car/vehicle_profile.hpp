@@ -74,7 +74,11 @@
 // duplicate channel, unknown DBC message or signal, a DBC that cannot be read, a missing unit
 // (empty DBC unit for a dimensioned channel and no dbc_unit/factor), an unconvertible unit,
 // a non-finite or non-positive number where one is required, an unknown model or a model whose
-// constants it rejects, an unknown constant name in scale/divide_by.
+// constants it rejects, an unknown constant name in scale/divide_by; in [[sources]]: a name that
+// breaks the id rule or repeats, an unknown type or time unit, a source channel without a unit
+// or with one of another quantity, a channel given by two sources, a bus channel given by a
+// source without replaces_bus, a clock that is neither an offset nor an estimate from a channel
+// of the source against a bus channel.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
