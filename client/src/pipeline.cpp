@@ -1,5 +1,8 @@
 #include "dynid/car/pipeline.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace dynid::car {
 namespace {
 
@@ -27,15 +30,48 @@ CarPipeline::CarPipeline(const VehicleProfile& profile, const std::string& run,
                    builder_.add_row(k, row, valid);
                  }) {}
 
+double CarPipeline::run_time(double source_time) {
+  if (!first_time_) first_time_ = source_time;
+  return static_cast<double>(std::llround((source_time - *first_time_) * 1e6)) / 1e6;
+}
+
+void CarPipeline::add_auxiliary(std::vector<AuxiliarySample> samples) {
+  aux_ = std::move(samples);
+  aux_next_ = 0;
+}
+
+// Auxiliary samples up to `source_time` into the resampler (those before the first frame dropped).
+void CarPipeline::push_auxiliary_until(double source_time) {
+  for (; aux_next_ < aux_.size() && aux_[aux_next_].time <= source_time; ++aux_next_) {
+    const AuxiliarySample& a = aux_[aux_next_];
+    if (!first_time_ || a.time < *first_time_) {
+      ++aux_stats_.before_bus;
+      continue;
+    }
+    resampler_.push(a.channel, run_time(a.time), a.value);
+    ++aux_stats_.merged;
+  }
+}
+
 void CarPipeline::on_frame(const can::Frame& frame) {
   samples_.clear();
   if (mapper_.map(frame, samples_) == FrameOutcome::BadTime) return;  // not a time the grid can hold
-  for (const auto& s : samples_) resampler_.push(s.channel, s.time, s.value);
+  const double t = run_time(frame.timestamp);
+  last_time_ = std::max(last_time_, frame.timestamp);
+  if (aux_next_ < aux_.size()) push_auxiliary_until(frame.timestamp);
+  for (const auto& s : samples_) resampler_.push(s.channel, t, s.value);
   // Every frame moves the clock, so a silent channel is declared stale in time.
-  resampler_.advance_clock(frame.timestamp);
+  resampler_.advance_clock(t);
+}
+
+void CarPipeline::idle(double time) {
+  if (first_time_) resampler_.idle(run_time(time));
 }
 
 void CarPipeline::finish() {
+  if (first_time_) push_auxiliary_until(last_time_);
+  aux_stats_.after_bus += aux_.size() - aux_next_;
+  aux_next_ = aux_.size();
   resampler_.finish();
   builder_.flush();
 }

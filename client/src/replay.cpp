@@ -66,13 +66,13 @@ ReplayProgress replay(FrameSource& source, CarPipeline& pipeline, const ReplayOp
 }
 
 std::string replay_problem(const ReplayProgress& c) {
-  if (c.frames == 0) return "no candump frame (" + std::to_string(c.bad_lines) + " bad lines)";
+  if (c.frames == 0) return "no CAN frame (" + std::to_string(c.bad_lines) + " bad lines)";
   if (c.mapped == 0)
     return "none of its " + std::to_string(c.frames) + " frames gives a channel of the profile (" +
            std::to_string(c.decoded) + " decoded by its DBC, " + std::to_string(c.unknown_id) + " unknown ids, " +
            std::to_string(c.other_interface) + " of other interfaces)";
   if (c.bad_lines > c.frames)
-    return "most lines are not candump frames (" + std::to_string(c.bad_lines) + " bad lines, " +
+    return "most lines or objects are not CAN frames (" + std::to_string(c.bad_lines) + " bad lines, " +
            std::to_string(c.frames) + " frames)";
   return "";
 }

@@ -7,7 +7,7 @@ namespace dynid::car {
 
 SignalMapper::SignalMapper(const VehicleProfile& profile) : profile_(profile), decoder_(*profile.dbc) {
   for (std::size_t c = 0; c < profile_.channels.size(); ++c)
-    channels_of_[profile_.channels[c].dbc_message].push_back(c);
+    if (!profile_.channels[c].source) channels_of_[profile_.channels[c].dbc_message].push_back(c);  // bus channels
 }
 
 FrameOutcome SignalMapper::map(const can::Frame& frame, std::vector<ChannelSample>& out) {

@@ -109,20 +109,24 @@ class Reader {
   std::filesystem::path source_;
 };
 
+// The DBC and interfaces of a bus: [vehicle], or a type = "can" source (`prefix` its key).
+void read_bus(const Reader& r, const toml::table& v, const std::string& prefix, VehicleProfile& p) {
+  p.dbc_path = r.relative_path(r.string(v, "dbc", prefix + "dbc"));
+  try {
+    p.dbc = std::make_shared<const can::Database>(can::parse_dbc_file(p.dbc_path));
+  } catch (const std::exception& e) {
+    r.fail(prefix + "dbc", "cannot read the DBC '" + p.dbc_path.string() + "': " + e.what(), v.get("dbc"));
+  }
+  if (const toml::node* n = v.get("interfaces")) p.interfaces = r.strings(*n, prefix + "interfaces");
+}
+
 void read_vehicle(const Reader& r, const toml::table& root, VehicleProfile& p) {
   const toml::table& v = r.table(root, "vehicle");
   r.only_keys(v, {"id", "dbc", "interfaces"}, "vehicle.");
   p.vehicle = r.string(v, "id", "vehicle.id");
   if (const std::string problem = input::id_problem(p.vehicle); !problem.empty())
     r.fail("vehicle.id", "'" + input::printable(p.vehicle) + "' " + problem, v.get("id"));
-  p.dbc_path = r.relative_path(r.string(v, "dbc", "vehicle.dbc"));
-  try {
-    p.dbc = std::make_shared<const can::Database>(can::parse_dbc_file(p.dbc_path));
-  } catch (const std::exception& e) {
-    r.fail("vehicle.dbc", "cannot read the DBC '" + p.dbc_path.string() + "': " + e.what(),
-           v.get("dbc"));
-  }
-  if (const toml::node* n = v.get("interfaces")) p.interfaces = r.strings(*n, "vehicle.interfaces");
+  read_bus(r, v, "vehicle.", p);
 }
 
 void read_grid(const Reader& r, const toml::table& root, VehicleProfile& p) {
@@ -256,11 +260,24 @@ std::vector<std::string> signal_names(const Reader& r, const toml::table& t, con
   return names;
 }
 
+double read_sign(const Reader& r, const toml::table& t, const std::string& key) {
+  const toml::node* s = t.get("sign");
+  if (s == nullptr) return 1.0;
+  const auto v = s->value<std::int64_t>();
+  if (!s->is_integer() || (*v != 1 && *v != -1)) r.fail(key + ".sign", "expected 1 or -1", s);
+  return static_cast<double>(*v);
+}
+
 ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml::table& t,
-                            const std::string& key) {
-  r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
-                  "scale", "divide_by", "sign", "max_gap"},
-              key + ".");
+                            const std::string& key, bool in_source = false) {
+  if (in_source)  // a channel of a second bus (type = "can" source)
+    r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
+                    "scale", "divide_by", "sign", "max_gap", "replaces_bus"},
+                key + ".");
+  else
+    r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
+                    "scale", "divide_by", "sign", "max_gap"},
+                key + ".");
   ChannelMapping m;
   m.channel = r.string(t, "name", key + ".name");
   const auto unit = model::channel_unit(m.channel);
@@ -289,11 +306,7 @@ ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml
   }
   if (const toml::node* s = t.get("scale")) m.gain *= gain_term(r, p, *s, key + ".scale");
   if (const toml::node* d = t.get("divide_by")) m.gain /= gain_term(r, p, *d, key + ".divide_by");
-  if (const toml::node* s = t.get("sign")) {
-    const auto v = s->value<std::int64_t>();
-    if (!s->is_integer() || (*v != 1 && *v != -1)) r.fail(key + ".sign", "expected 1 or -1", s);
-    m.gain *= static_cast<double>(*v);
-  }
+  m.gain *= read_sign(r, t, key);
   if (t.contains("max_gap")) m.max_gap = r.at_most(t, "max_gap", key + ".max_gap", kMaxSeconds);
   return m;
 }
@@ -311,6 +324,143 @@ void read_channels(const Reader& r, const toml::table& root, VehicleProfile& p) 
     if (!seen.insert(r.string(t, "name", key + ".name")).second)
       r.fail(key + ".name", "duplicate channel '" + *t["name"].value<std::string>() + "'", t.get("name"));
     p.channels.push_back(read_channel(r, p, t, key));
+  }
+}
+
+bool read_bool(const Reader& r, const toml::table& t, const std::string& name, const std::string& key) {
+  const toml::node* n = t.get(name);
+  if (n == nullptr) return false;
+  if (!n->is_boolean()) r.fail(key + "." + name, "expected true or false", n);
+  return *n->value<bool>();
+}
+
+SourceChannel read_source_channel(const Reader& r, const VehicleProfile& p, const toml::table& t,
+                                  const std::string& key) {
+  r.only_keys(t, {"column", "channel", "unit", "scale", "sign", "max_gap", "replaces_bus"}, key + ".");
+  SourceChannel c;
+  c.column = r.string(t, "column", key + ".column");
+  c.channel = r.string(t, "channel", key + ".channel");
+  const auto unit = model::channel_unit(c.channel);
+  if (!unit) r.fail(key + ".channel", "unknown channel '" + c.channel + "' (see docs/CHANNELS.md)", t.get("channel"));
+  c.unit = *unit;
+  if (!t.contains("unit"))
+    r.fail(key + ".unit", "missing unit: give the unit of column '" + c.column + "' (channel '" + c.channel +
+                              "' is in '" + c.unit + "'; \"-\" for a unitless column)");
+  c.given_unit = r.string(t, "unit", key + ".unit");
+  const auto conv = conversion(c.given_unit, c.unit);
+  if (!conv)
+    r.fail(key + ".unit", "cannot convert column '" + c.column + "' from '" + c.given_unit + "' to '" + c.unit +
+                              "' (channel '" + c.channel + "')", t.get("unit"));
+  c.to_si = *conv;
+  if (const toml::node* s = t.get("scale")) c.gain *= gain_term(r, p, *s, key + ".scale");
+  c.gain *= read_sign(r, t, key);
+  if (t.contains("max_gap")) c.max_gap = r.at_most(t, "max_gap", key + ".max_gap", kMaxSeconds);
+  c.replaces_bus = read_bool(r, t, "replaces_bus", key);
+  return c;
+}
+
+SourceClockRelation read_clock(const Reader& r, const toml::table& src, const std::string& key) {
+  const toml::node* n = src.get("clock");
+  if (n == nullptr) r.fail(key + ".clock", "missing: give clock = { offset = <s> } or clock = { estimate_from = "
+                                           "\"<channel of this source>\", reference = \"<bus channel>\" }");
+  if (!n->is_table()) r.fail(key + ".clock", "expected a table", n);
+  const toml::table& t = *n->as_table();
+  r.only_keys(t, {"offset", "estimate_from", "reference", "reference_derivative", "max_offset"}, key + ".clock.");
+  SourceClockRelation c;
+  if (const toml::node* o = t.get("offset")) {
+    if (t.contains("estimate_from") || t.contains("reference"))
+      r.fail(key + ".clock", "give either offset or estimate_from/reference, not both", n);
+    c.offset = r.number(*o, key + ".clock.offset");
+    return c;
+  }
+  c.estimate_from = r.string(t, "estimate_from", key + ".clock.estimate_from");
+  c.reference = r.string(t, "reference", key + ".clock.reference");
+  c.reference_derivative = read_bool(r, t, "reference_derivative", key + ".clock");
+  if (t.contains("max_offset")) c.max_offset = r.at_most(t, "max_offset", key + ".clock.max_offset", 60.0);
+  return c;
+}
+
+void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
+  const toml::node* n = root.get("sources");
+  if (n == nullptr) return;
+  const toml::array* a = n->as_array();
+  if (a == nullptr || !a->is_array_of_tables()) r.fail("sources", "expected an array of tables ([[sources]])", n);
+  std::set<std::string> names;
+  std::set<std::string> channels;
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    const std::string key = "sources[" + std::to_string(i) + "]";
+    const toml::table& t = *a->get(i)->as_table();
+    AuxiliarySourceSpec s;
+    s.type = r.string(t, "type", key + ".type");
+    if (s.type != "csv" && s.type != "can")
+      r.fail(key + ".type", "unknown source type '" + s.type + "' (\"csv\" or \"can\")", t.get("type"));
+    if (s.type == "csv")
+      r.only_keys(t, {"name", "type", "file", "time_column", "time_unit", "clock", "channels"}, key + ".");
+    else
+      r.only_keys(t, {"name", "type", "file", "dbc", "interfaces", "clock", "channels"}, key + ".");
+    s.name = r.string(t, "name", key + ".name");
+    if (const std::string problem = input::id_problem(s.name); !problem.empty())
+      r.fail(key + ".name", "'" + input::printable(s.name) + "' " + problem, t.get("name"));
+    if (!names.insert(s.name).second) r.fail(key + ".name", "duplicate source '" + s.name + "'", t.get("name"));
+    if (t.contains("file")) s.file = r.relative_path(r.string(t, "file", key + ".file"));
+    std::shared_ptr<VehicleProfile> bus;
+    if (s.type == "csv") {
+      s.time_column = r.string(t, "time_column", key + ".time_column");
+      const std::string unit = r.string(t, "time_unit", key + ".time_unit");
+      if (unit == "s") s.time_scale = 1.0;
+      else if (unit == "ms") s.time_scale = 1e-3;
+      else if (unit == "us") s.time_scale = 1e-6;
+      else if (unit == "ns") s.time_scale = 1e-9;
+      else r.fail(key + ".time_unit", "expected \"s\", \"ms\", \"us\" or \"ns\"", t.get("time_unit"));
+    } else {
+      bus = std::make_shared<VehicleProfile>();
+      bus->source = p.source;
+      bus->vehicle = p.vehicle;
+      bus->constants = p.constants;
+      read_bus(r, t, key + ".", *bus);
+    }
+    s.clock = read_clock(r, t, key);
+    const toml::node* cn = t.get("channels");
+    const toml::array* ca = cn == nullptr ? nullptr : cn->as_array();
+    if (ca == nullptr || !ca->is_array_of_tables() || ca->empty())
+      r.fail(key + ".channels", "expected a non-empty array of tables ([[sources.channels]])", cn);
+    for (std::size_t j = 0; j < ca->size(); ++j) {
+      const std::string ckey = key + ".channels[" + std::to_string(j) + "]";
+      const toml::table& ct = *ca->get(j)->as_table();
+      SourceChannel c;
+      if (bus) {  // a mapping of the second bus, as [[channels]]
+        ChannelMapping m = read_channel(r, *bus, ct, ckey, true);
+        c.column = m.message;
+        c.channel = m.channel;
+        c.unit = m.unit;
+        c.max_gap = m.max_gap;
+        c.replaces_bus = read_bool(r, ct, "replaces_bus", ckey);
+        bus->channels.push_back(std::move(m));
+      } else {
+        c = read_source_channel(r, p, ct, ckey);
+      }
+      if (!channels.insert(c.channel).second)
+        r.fail(ckey + ".channel", "channel '" + c.channel + "' comes from two sources", ct.get("channel"));
+      bool on_bus = false;
+      for (const auto& m : p.channels) on_bus = on_bus || m.channel == c.channel;
+      if (on_bus && !c.replaces_bus)
+        r.fail(ckey + ".channel", "channel '" + c.channel + "' is also a bus channel ([[channels]]): say "
+                                  "replaces_bus = true to take it from this source when the source is given",
+               ct.get("channel"));
+      if (!on_bus && c.replaces_bus)
+        r.fail(ckey + ".replaces_bus", "no bus channel '" + c.channel + "' to replace", ct.get("replaces_bus"));
+      s.channels.push_back(std::move(c));
+    }
+    s.bus = bus;
+    if (!s.clock.offset) {
+      bool mine = false;
+      for (const auto& c : s.channels) mine = mine || c.channel == s.clock.estimate_from;
+      if (!mine) r.fail(key + ".clock.estimate_from", "'" + s.clock.estimate_from + "' is not a channel of this source");
+      bool known = false;
+      for (const auto& m : p.channels) known = known || m.channel == s.clock.reference;
+      if (!known) r.fail(key + ".clock.reference", "'" + s.clock.reference + "' is not a bus channel ([[channels]])");
+    }
+    p.sources.push_back(std::move(s));
   }
 }
 
@@ -351,7 +501,7 @@ VehicleProfile parse_vehicle_profile(std::string_view text, const std::filesyste
         << ": TOML syntax: " << e.description();
     throw InputError(msg.str());
   }
-  r.only_keys(root, {"vehicle", "grid", "spool", "constants", "models", "channels"}, "");
+  r.only_keys(root, {"vehicle", "grid", "spool", "constants", "models", "channels", "sources"}, "");
   VehicleProfile p;
   p.source = source;
   read_vehicle(r, root, p);
@@ -360,6 +510,7 @@ VehicleProfile parse_vehicle_profile(std::string_view text, const std::filesyste
   if (root.contains("constants")) p.constants = read_constants(r, r.table(root, "constants"), "constants.");
   read_models(r, root, p);
   read_channels(r, root, p);
+  read_sources(r, root, p);
   return p;
 }
 

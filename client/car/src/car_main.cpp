@@ -1,4 +1,5 @@
-// dynid-car: the car-side client. Reads the CAN bus (SocketCAN) or replays a candump log,
+// dynid-car: the car-side client. Reads the CAN bus (SocketCAN) or replays a CAN log (candump,
+// Vector ASC or BLF: can/log_reader.hpp),
 // decodes it with the vehicle profile, cuts chunks, keeps them in the spool and delivers them to
 // the server until it acknowledges them durably (delivery.hpp).
 //
@@ -37,13 +38,16 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <map>
 #include <string>
+#include <vector>
 
 #include <dynid/dds/participant.hpp>
 #include <dynid/error.hpp>
 #include <dynid/input/option_checks.hpp>
 
-#include "dynid/car/candump_source.hpp"
+#include "dynid/car/auxiliary.hpp"
+#include "dynid/car/log_source.hpp"
 #include "dynid/car/chunk_file.hpp"
 #include "dynid/car/delivery.hpp"
 #include "dynid/car/pipeline.hpp"
@@ -74,6 +78,7 @@ struct Options {
   double ack_timeout = 5.0;
   std::string chunks_out;
   std::uint64_t max_frames = 0;  // live: stop after this many frames (0: only on a signal)
+  std::vector<std::string> sources;  // --source NAME=FILE
 };
 
 constexpr const char* kLogPattern = "dynid-car %l: %v";
@@ -131,12 +136,42 @@ double at_log_resolution(double seconds) {
   return static_cast<double>(std::llround(seconds * 1e6)) / 1e6;
 }
 
+// The profile of this run: the declared one with the auxiliary sources given (auxiliary.hpp),
+// their clocks put on the bus's (an estimate reads the replayed log once), reported.
+RunSources run_profile(const Options& options) {
+  const VehicleProfile declared = load_vehicle_profile(options.profile);
+  std::map<std::string, std::filesystem::path> given;
+  for (const auto& s : options.sources) {
+    const std::size_t eq = s.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == s.size())
+      throw dynid::InputError("--source '" + dynid::input::printable(s) + "': expected NAME=FILE");
+    if (!given.emplace(s.substr(0, eq), s.substr(eq + 1)).second)
+      throw dynid::InputError("--source " + dynid::input::printable(s.substr(0, eq)) + " given twice");
+  }
+  std::optional<LogSource> bus;
+  if (!options.replay.empty()) bus.emplace(options.replay);
+  RunSources run = prepare_sources(declared, given, bus ? &*bus : nullptr);
+  for (const auto& r : run.reports) {
+    spdlog::info("{}", r.describe());
+    for (const auto& w : r.warnings) spdlog::warn("source '{}': {}", r.name, w);
+  }
+  return run;
+}
+
+// The auxiliary samples into the pipeline; what was merged is logged at the end.
+void log_auxiliary(const CarPipeline& pipe) {
+  const AuxiliaryStats& a = pipe.auxiliary_stats();
+  if (a.merged + a.before_bus + a.after_bus == 0) return;
+  spdlog::info("auxiliary sources: {} samples merged into the grid, {} before the first frame and {} after the last "
+               "dropped", a.merged, a.before_bus, a.after_bus);
+}
+
 // Lines of a log judged before anything of it is announced, spooled or written: enough to tell
 // a log from another file at once, few enough that the probe costs nothing (about 5 ms).
 constexpr std::uint64_t kProbeLines = 10000;
 
 // "<file>: <reason>", with the first bad line's reason when there is one.
-std::string log_problem(const Options& options, const CandumpSource& source, const std::string& problem) {
+std::string log_problem(const Options& options, const LogSource& source, const std::string& problem) {
   const auto errors = source.errors();
   return options.replay + ": not a CAN log this profile can use: " + problem +
          (errors.empty() ? "" : "; first: " + errors.front());
@@ -144,7 +179,7 @@ std::string log_problem(const Options& options, const CandumpSource& source, con
 
 // A file the replay would make nothing of fails here, before any state changes.
 void probe_log(const Options& options, const VehicleProfile& profile) {
-  CandumpSource source(options.replay, kProbeLines);
+  LogSource source(options.replay, kProbeLines);
   const std::string problem = replay_problem(probe(source, profile, kProbeLines));
   if (!problem.empty())
     throw dynid::InputError(log_problem(options, source, problem + " in its first " + std::to_string(kProbeLines) +
@@ -155,12 +190,15 @@ void probe_log(const Options& options, const VehicleProfile& profile) {
 // Returns replay_problem() of the whole log as "<file>: <reason>", or "".
 std::string replay_log(const Options& options, CarPipeline& pipe,
                        std::function<void(const ReplayProgress&)> on_progress) {
-  CandumpSource source(options.replay);
+  LogSource source(options.replay);
   ReplayOptions ro;
   ro.speed = options.fast ? 0.0 : options.speed;
   ro.progress_interval = 100ms;  // also how often acknowledgements are taken while replaying
   ro.on_progress = std::move(on_progress);
   const ReplayProgress done = replay(source, pipe, ro);
+  log_auxiliary(pipe);
+  if (done.rows > 0)  // where the run's times (row / rate) sit on the log's clock, e.g. to compare with its GNSS
+    spdlog::info("grid row 0 is at {:.6f} s of the log's clock", pipe.origin());
   spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids, {} timestamps out of range), {:.1f} s of "
                "log, {} jumps of its clock, {} chunks",
                done.frames, source.bad_input(), done.unknown_id, pipe.mapper_stats().bad_time, done.log_seconds,
@@ -201,6 +239,7 @@ void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe
     }
   }
   pipe.finish();
+  log_auxiliary(pipe);
   spdlog::info("bus {} closed: {} frames, {} error frames, {} dropped by the kernel, {} chunks", options.can,
                source.frames(), source.error_frames(), source.dropped(), pipe.chunks());
 }
@@ -208,6 +247,7 @@ void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe
 struct Session {
   const Options& options;
   const VehicleProfile& profile;
+  std::vector<AuxiliarySample> auxiliary;  // into the run's one pipeline
   Spool& spool;
   Delivery& delivery;
   ProgressDisplay& display;
@@ -227,10 +267,12 @@ struct Session {
 
   // The sink of the pipeline: spool, then send. SpoolFull propagates and stops the reading.
   CarPipeline pipeline(const std::string& run) {
-    return CarPipeline(profile, run, [this](dynid::ingest::Chunk&& chunk) {
+    CarPipeline pipe(profile, run, [this](dynid::ingest::Chunk&& chunk) {
       delivery.submit(chunk);
       if (g_stop.load()) throw Interrupted{};
     });
+    pipe.add_auxiliary(std::move(auxiliary));
+    return pipe;
   }
 
   void replay_run(const std::string& run) {
@@ -306,7 +348,8 @@ struct Session {
 
 // --chunks-out: the same reading and pipeline, the chunks written to a file instead of delivered.
 int write_chunks(const Options& options) {
-  const VehicleProfile profile = load_vehicle_profile(options.profile);
+  RunSources sources = run_profile(options);
+  const VehicleProfile& profile = sources.profile;
   if (!options.replay.empty()) probe_log(options, profile);
   // The source is opened before the chunk file is created: a bus that cannot be read leaves none.
   std::optional<SocketCanSource> live;
@@ -314,6 +357,7 @@ int write_chunks(const Options& options) {
   const std::string run = options.run.empty() ? default_run_id() : options.run;
   ChunkFileWriter writer(options.chunks_out);
   CarPipeline pipe(profile, run, [&writer](dynid::ingest::Chunk&& chunk) { writer.write(chunk); });
+  pipe.add_auxiliary(std::move(sources.samples));
   spdlog::info("run {}/{}: {} channels at {} Hz, {} rows per chunk, chunks to {}", profile.vehicle, run,
                profile.channels.size(), profile.rate_hz, profile.chunk_rows, options.chunks_out);
   std::string problem;
@@ -341,7 +385,8 @@ int write_chunks(const Options& options) {
 int run(const Options& options, ProgressDisplay& display) {
   // Every input is checked before the spool is touched.
   const std::string cyclone_config = dynid::dds::config_uri(options.cyclone_config);
-  const VehicleProfile profile = load_vehicle_profile(options.profile);
+  RunSources sources = run_profile(options);
+  const VehicleProfile& profile = sources.profile;
   if (!options.replay.empty()) probe_log(options, profile);
   const std::filesystem::path spool_dir = options.spool.empty() ? profile.spool_directory : std::filesystem::path(options.spool);
   Spool spool(spool_dir, profile.spool_max_bytes);
@@ -358,7 +403,7 @@ int run(const Options& options, ProgressDisplay& display) {
   });
 
 
-  Session session{options, profile, spool, delivery, display};
+  Session session{options, profile, std::move(sources.samples), spool, delivery, display};
   if (!options.replay.empty() || !options.can.empty()) session.read_source();
   const bool drained = session.drain();
   const auto& s = delivery.stats();
@@ -390,7 +435,7 @@ int main(int argc, char** argv) {
                  "Cyclone DDS configuration: a file (deploy/cyclonedds/*.xml), or file:// URIs and XML "
                  "fragments, comma-separated, as in CYCLONEDDS_URI (required unless --chunks-out)");
   app.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 230));
-  auto* replay_opt = app.add_option("--replay", o.replay, "replay this candump -l log")->check(input::input_file("CAN log"));
+  auto* replay_opt = app.add_option("--replay", o.replay, "replay this CAN log (candump -l, Vector ASC or BLF, told by its content)")->check(input::input_file("CAN log"));
   auto* can_opt = app.add_option("--can", o.can, "read this SocketCAN interface live (e.g. can0)");
   replay_opt->excludes(can_opt);
   auto* speed_opt = app.add_option("--speed", o.speed, "replay speed (1 = real time)")
@@ -400,6 +445,9 @@ int main(int argc, char** argv) {
                  "no server: write the run's chunks to this file (length-prefixed "
                  "encode_chunk records) and exit")
       ->check(input::output_file("chunk file"));
+  app.add_option("--source", o.sources,
+                 "NAME=FILE: the file of the profile's auxiliary source NAME for this run (repeatable; "
+                 "overrides the profile's file)");
   app.add_option("--max-frames", o.max_frames, "live: stop after this many frames")
       ->check(input::within(1, kMaxFrames))->needs(can_opt);
   app.add_option("--spool", o.spool, "spool folder (default: the profile's [spool] directory)");

@@ -8,12 +8,12 @@
 #include <istream>
 #include <ostream>
 
+#include "log_text.hpp"
+
 namespace dynid::can {
 namespace {
 
 constexpr std::uint32_t kCanErrFlag = 0x20000000U;  // Linux CAN_ERR_FLAG in an 8-digit id
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 
 int hex_value(char c) {
   if (c >= '0' && c <= '9') return c - '0';
@@ -22,24 +22,9 @@ int hex_value(char c) {
   return -1;
 }
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-// Cuts the next blank-separated word off `s`.
-std::string_view next_word(std::string_view& s) {
-  s = trim(s);
-  std::size_t n = 0;
-  while (n < s.size() && !is_space(s[n])) ++n;
-  const std::string_view w = s.substr(0, n);
-  s.remove_prefix(n);
-  return w;
-}
-
-// Escaped: a log's bytes reach messages and log lines (input/ids.hpp printable()).
-std::string quoted(std::string_view s) { return "'" + input::printable(s.substr(0, 40)) + "'"; }
+using detail::next_word;
+using detail::quoted;
+using detail::trim;
 
 std::string parse_timestamp(std::string_view word, Frame& f) {
   if (word.size() < 3 || word.front() != '(' || word.back() != ')')
@@ -140,14 +125,6 @@ void check_writable(const Frame& f) {
   if (f.fd && f.rtr) throw InputError("candump writer: CAN FD has no remote frames");
 }
 
-// Checked before opening: opening a FIFO would block until a writer appears.
-std::unique_ptr<std::ifstream> open_log(const std::filesystem::path& path) {
-  input::check_input_file(path, "candump log");
-  auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
-  if (!*file) throw InputError(path.string() + ": cannot open the candump log");
-  return file;
-}
-
 }  // namespace
 
 std::string parse_candump_line(std::string_view line, Frame& frame) {
@@ -161,7 +138,9 @@ std::string parse_candump_line(std::string_view line, Frame& frame) {
   const std::string_view word = next_word(rest);
   if (word.empty()) return "missing frame after the interface name";
   if (std::string err = parse_frame(word, frame); !err.empty()) return err;
-  if (!trim(rest).empty()) return "unexpected text after the frame: " + quoted(trim(rest));
+  // python-can's candump writer adds the direction, " R" (received) or " T" (sent).
+  const std::string_view tail = trim(rest);
+  if (!tail.empty() && tail != "R" && tail != "T") return "unexpected text after the frame: " + quoted(tail);
   return {};
 }
 
@@ -183,50 +162,9 @@ std::string format_candump_line(const Frame& f) {
   return out;
 }
 
-CandumpReader::CandumpReader(std::istream& in, std::string source, OnError on_error)
-    : in_(&in), source_(std::move(source)), on_error_(on_error) {}
-
-CandumpReader::CandumpReader(const std::filesystem::path& path, OnError on_error)
-    : file_(open_log(path)), in_(file_.get()), source_(path.filename().string()), on_error_(on_error) {}
-
-// getline with a bound: a line is read in pieces of at most kMaxLineBytes, so neither memory nor
-// the time one call takes grows with a line's length. `too_long`: this piece is (part of) a line
-// of kMaxLineBytes or more; `continued`: it is not the start of its line.
-bool CandumpReader::read_line(bool& too_long, bool& continued) {
-  continued = in_long_line_;
-  buffer_.resize(kMaxLineBytes + 1);
-  in_->getline(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
-  const auto got = static_cast<std::size_t>(in_->gcount());
-  if (got == 0 && in_->fail()) return false;  // nothing left
-  const bool delimited = !in_->fail() && !in_->eof();  // the '\n' was extracted and counted
-  in_long_line_ = in_->fail() && !in_->eof();       // the buffer filled before a '\n'
-  if (in_long_line_) in_->clear();
-  too_long = continued || in_long_line_;
-  buffer_.resize(delimited ? got - 1 : got);
-  return true;
-}
-
-bool CandumpReader::next(Frame& frame) {
-  bool too_long = false;
-  bool continued = false;
-  while (!stopped_ && read_line(too_long, continued)) {
-    if (!continued) ++line_;
-    if (!too_long && trim(buffer_).empty()) continue;
-    std::string reason = too_long ? "line longer than " + std::to_string(kMaxLineBytes) + " bytes"
-                                  : parse_candump_line(buffer_, frame);
-    if (reason.empty()) {
-      ++frame_count_;
-      return true;
-    }
-    ++error_count_;
-    if (errors_.size() < kMaxKeptErrors) errors_.push_back(LogError{line_, std::move(reason)});
-    stopped_ = on_error_ == OnError::Stop || error_count_ >= max_errors_;
-  }
-  return false;
-}
-
-std::string CandumpReader::describe(const LogError& error) const {
-  return source_ + ":" + std::to_string(error.line) + ": " + error.reason;
+std::string CandumpReader::parse_line(std::string_view line, Frame& frame, bool& is_frame) {
+  is_frame = true;
+  return parse_candump_line(line, frame);
 }
 
 void CandumpWriter::write(const Frame& frame) { out_ << format_candump_line(frame) << '\n'; }

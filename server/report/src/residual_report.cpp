@@ -236,6 +236,19 @@ json fit_groups(const residual::ModelFit& f) {
   return out;
 }
 
+// The added effect's fitted contribution row by row, with the rows' run times (a road profile's:
+// g sin(grade), centred): what a caller compares with an independent measurement of the effect.
+json effect_series(const residual::ModelFit& after) {
+  json out = json::array();
+  for (const residual::ResidualSeries& s : after.series) {
+    if (s.effect_contribution.size() != static_cast<Eigen::Index>(s.time_s.size())) continue;
+    json contribution = json::array();
+    for (Eigen::Index i = 0; i < s.effect_contribution.size(); ++i) contribution.push_back(finite(s.effect_contribution(i)));
+    out.push_back({{"group", s.group}, {"time_s", s.time_s}, {"contribution", contribution}});
+  }
+  return out;
+}
+
 json comparison_object(const residual::EffectComparison& c) {
   json parameters = json::array();
   for (const residual::ParameterChange& p : c.parameters)
@@ -253,7 +266,8 @@ json comparison_object(const residual::EffectComparison& c) {
           {"groups_before", fit_groups(c.before)},
           {"groups_after", fit_groups(c.after)},
           {"in_sample_drop", finite(c.in_sample_drop())},
-          {"held_out_drop", finite(c.held_out_drop())}};
+          {"held_out_drop", finite(c.held_out_drop())},
+          {"effect_series", effect_series(c.after)}};
 }
 
 }  // namespace

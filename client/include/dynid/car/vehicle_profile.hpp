@@ -36,6 +36,32 @@
 //   # divide_by (a number or the name of a [constants] entry, e.g. "steering_ratio"),
 //   # sign = -1, max_gap (seconds, at most 3600, instead of the derived window).
 //
+//   [[sources]]                        # optional: auxiliary sources besides the bus (auxiliary.hpp)
+//   name = "recorder_imu"              # the id rule (input/ids.hpp); dynid-car --source NAME=FILE
+//   type = "csv"                       # a time-stamped CSV file, one header line
+//   file = "imu.csv"                   # optional, relative to this profile; --source overrides
+//   time_column = "t"
+//   time_unit = "s"                    # s, ms, us or ns
+//   clock = { offset = 0.0 }           # bus time = source time + offset (seconds), or
+//   clock = { estimate_from = "ax", reference = "ax", max_offset = 2.0, reference_derivative = false }
+//   [[sources.channels]]
+//   column = "ax"                      # a column of the header
+//   channel = "ax"                     # catalogue channel
+//   unit = "m/s^2"                     # required: the column's unit, converted to the channel's
+//   # optional: scale, sign = -1, max_gap (as for bus channels), replaces_bus = true (the bus
+//   # mapping of this channel gives way when the source is given for a run)
+//   [[sources]]                        # a second CAN log (candump, ASC, BLF) with its own DBC
+//   name = "chassis"
+//   type = "can"
+//   dbc = "chassis.dbc"                # relative to this profile
+//   interfaces = ["can1"]              # optional, as [vehicle] interfaces
+//   file = "chassis.blf"               # optional; --source chassis=FILE
+//   clock = { offset = 0.0 }           # as above
+//   [[sources.channels]]               # written as [[channels]] are, plus replaces_bus
+//   name = "roll_rate"
+//   message = "IMU2"
+//   signal = "RollRate"
+//
 // Value of a channel sample: sign * scale / divide_by * combine_i(conv_i(dbc_value_i)), where
 // conv_i converts signal i from its DBC unit to the channel's SI unit. All signals of a channel
 // come from one message, so they share a timestamp and combining them needs no resampling.
@@ -48,7 +74,11 @@
 // duplicate channel, unknown DBC message or signal, a DBC that cannot be read, a missing unit
 // (empty DBC unit for a dimensioned channel and no dbc_unit/factor), an unconvertible unit,
 // a non-finite or non-positive number where one is required, an unknown model or a model whose
-// constants it rejects, an unknown constant name in scale/divide_by.
+// constants it rejects, an unknown constant name in scale/divide_by; in [[sources]]: a name that
+// breaks the id rule or repeats, an unknown type or time unit, a source channel without a unit
+// or with one of another quantity, a channel given by two sources, a bus channel given by a
+// source without replaces_bus, a clock that is neither an offset nor an estimate from a channel
+// of the source against a bus channel.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -84,10 +114,50 @@ struct ChannelMapping {
   Combine combine = Combine::Sum;
   double gain = 1.0;    ///< sign * scale / divide_by
   std::optional<double> max_gap;  ///< seconds; unset: derived from the signal's period
+  /// Set for a channel of an auxiliary source (with_sources()): index into
+  /// VehicleProfile::sources and into its channels; the bus decoder never sees it.
+  std::optional<std::size_t> source;
+  std::size_t source_channel = 0;
 
   /// The channel value from the message's decoded physical values (indexed like
   /// can::Message::signals).
   double value(const std::vector<double>& physical_by_signal) const;
+};
+
+/// One column of an auxiliary source mapped to a catalogue channel.
+struct SourceChannel {
+  std::string column;
+  std::string channel;
+  std::string unit;            ///< the catalogue's SI unit
+  std::string given_unit;      ///< the column's unit as the profile gives it
+  LinearConversion to_si;
+  double gain = 1.0;           ///< sign * scale
+  std::optional<double> max_gap;
+  bool replaces_bus = false;
+};
+
+/// How a source's clock relates to the bus: bus time = source time + offset.
+struct SourceClockRelation {
+  std::optional<double> offset;   ///< fixed; else estimated:
+  std::string estimate_from;      ///< a channel of this source
+  std::string reference;          ///< a bus channel of the profile ([[channels]])
+  bool reference_derivative = false;  ///< compare with d(reference)/dt (speed against acceleration)
+  double max_offset = 2.0;        ///< seconds searched either way
+};
+
+struct VehicleProfile;
+
+struct AuxiliarySourceSpec {
+  std::string name;
+  std::string type;               ///< "csv" or "can"
+  std::filesystem::path file;     ///< empty: given per run (--source NAME=FILE)
+  std::string time_column;        ///< csv
+  double time_scale = 1.0;        ///< csv: source time unit -> seconds
+  /// can: a second bus's log with its own DBC: the DBC, interfaces and channel mappings (in
+  /// the order of `channels`), decoded as the main bus's are.
+  std::shared_ptr<const VehicleProfile> bus;
+  SourceClockRelation clock;
+  std::vector<SourceChannel> channels;
 };
 
 struct VehicleProfile {
@@ -101,6 +171,9 @@ struct VehicleProfile {
   double max_gap_periods = 2.5;
   double max_time_jump = 10.0;  ///< seconds (TimeJumpLimits::forward)
   std::vector<ChannelMapping> channels;  ///< the column order of every chunk
+  /// Declared auxiliary sources; their channels join `channels` only for a run that gives them
+  /// (with_sources(), auxiliary.hpp): a profile as loaded maps the bus alone.
+  std::vector<AuxiliarySourceSpec> sources;
   model::Constants constants;
   std::vector<ingest::ModelSpec> models;
   std::filesystem::path spool_directory;

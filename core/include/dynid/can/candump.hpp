@@ -6,7 +6,8 @@
 //   123##<flags><data>     CAN FD: one hex nibble of flags (1 = BRS, 2 = ESI), up to 64 bytes
 //   123#R  or 123#R<dlc>   remote request (no data)
 //   123#                   empty payload
-// Data bytes may be separated by '.'. Blank lines are skipped.
+// Data bytes may be separated by '.'. Blank lines are skipped. A direction after the frame, " R"
+// (received) or " T" (sent), as python-can writes it, is allowed and ignored.
 //
 // Contract: the reader never throws for a bad line. It records the line number and reason,
 // counts it, and by default continues with the next line; with OnError::Stop it stops at the
@@ -20,6 +21,7 @@
 // (FIFO, directory, device) throws InputError naming it (input/input_file.hpp).
 #include <cstddef>
 #include <dynid/can/frame.hpp>
+#include <dynid/can/log_reader.hpp>
 #include <filesystem>
 #include <fstream>
 #include <iosfwd>
@@ -40,53 +42,22 @@ std::string parse_candump_line(std::string_view line, Frame& frame);
 // for its kind, classic length > 8, FD length not a valid FD length).
 std::string format_candump_line(const Frame& frame);
 
-struct LogError {
-  std::size_t line = 0;
-  std::string reason;
-};
-
-enum class OnError { Continue, Stop };
-
-class CandumpReader {
+class CandumpReader final : public LineLogReader {
  public:
-  static constexpr std::size_t kMaxKeptErrors = 1000;
   /// Far beyond the longest candump line (a 64-byte FD frame with dots is under 300 bytes).
   static constexpr std::size_t kMaxLineBytes = 1024;
 
   // Reads from `in`, which must outlive the reader; `source` names it in messages.
-  CandumpReader(std::istream& in, std::string source, OnError on_error = OnError::Continue);
+  CandumpReader(std::istream& in, std::string source, OnError on_error = OnError::Continue)
+      : LineLogReader(in, std::move(source), on_error, kMaxLineBytes) {}
   // Opens a file; throws InputError if it cannot be opened.
-  explicit CandumpReader(const std::filesystem::path& path, OnError on_error = OnError::Continue);
+  explicit CandumpReader(const std::filesystem::path& path, OnError on_error = OnError::Continue)
+      : LineLogReader(path, "candump log", on_error, kMaxLineBytes) {}
 
-  // The next good frame; false at the end of the input or after stopping on an error.
-  bool next(Frame& frame);
-  // Stop at the n-th error (counted from the start), whatever on_error says.
-  void stop_after_errors(std::size_t n) { max_errors_ = n; }
-
-  const std::vector<LogError>& errors() const { return errors_; }
-  std::size_t error_count() const { return error_count_; }
-  std::size_t frame_count() const { return frame_count_; }
-  std::size_t line_number() const { return line_; }
-  bool stopped() const { return stopped_; }
-  const std::string& source() const { return source_; }
-  // "<source>:<line>: <reason>" for one recorded error.
-  std::string describe(const LogError& error) const;
+  LogFormat format() const override { return LogFormat::Candump; }
 
  private:
-  bool read_line(bool& too_long, bool& continued);
-
-  std::unique_ptr<std::ifstream> file_;
-  std::istream* in_;
-  std::string source_;
-  OnError on_error_;
-  std::string buffer_;
-  std::vector<LogError> errors_;
-  std::size_t error_count_ = 0;
-  std::size_t frame_count_ = 0;
-  std::size_t line_ = 0;
-  bool stopped_ = false;
-  bool in_long_line_ = false;
-  std::size_t max_errors_ = static_cast<std::size_t>(-1);  // the last piece read filled the buffer before a newline
+  std::string parse_line(std::string_view line, Frame& frame, bool& is_frame) override;
 };
 
 class CandumpWriter {

@@ -1,0 +1,315 @@
+#include "dynid/car/auxiliary.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <set>
+
+#include <dynid/input/ids.hpp>
+#include <dynid/input/input_file.hpp>
+#include <dynid/input/number.hpp>
+
+#include "dynid/car/log_source.hpp"
+#include "dynid/car/signal_mapper.hpp"
+#include "dynid/error.hpp"
+
+namespace dynid::car {
+namespace {
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+std::vector<std::string_view> cells(std::string_view line) {
+  std::vector<std::string_view> out;
+  for (;;) {
+    const std::size_t comma = line.find(',');
+    out.push_back(trim(line.substr(0, comma)));
+    if (comma == std::string_view::npos) return out;
+    line.remove_prefix(comma + 1);
+  }
+}
+
+std::string fmt(double v, int digits = 3) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%+.*f", digits, v);
+  return buf;
+}
+
+// "offset -0.215 +- 0.014 s at the start, -0.189 +- 0.014 s at the end (drift +0.00046 +- 0.00035 s/s)"
+std::string drift_text(const ClockEstimate& e) {
+  char drift[96];
+  std::snprintf(drift, sizeof drift, "drift %+.5f +- %.5f s/s", e.drift, e.drift_std);
+  return "offset " + fmt(e.start) + " +- " + fmt(e.start_std).substr(1) + " s at the start, " + fmt(e.end) + " +- " +
+         fmt(e.end_std).substr(1) + " s at the end (" + drift + ")";
+}
+
+}  // namespace
+
+AuxiliaryTable read_auxiliary_csv(const AuxiliarySourceSpec& spec, const std::filesystem::path& file) {
+  const std::string text = input::read_input_file(file, "auxiliary source '" + spec.name + "'", kMaxAuxiliaryFileBytes);
+  const std::string where = file.string();
+  std::size_t pos = 0, line_no = 0;
+  const auto next_line = [&](std::string_view& line) {
+    if (pos >= text.size()) return false;
+    const std::size_t nl = text.find('\n', pos);
+    line = std::string_view(text).substr(pos, nl == std::string::npos ? std::string::npos : nl - pos);
+    pos = nl == std::string::npos ? text.size() : nl + 1;
+    ++line_no;
+    return true;
+  };
+  std::string_view line;
+  if (!next_line(line)) throw InputError(where + ": auxiliary source '" + spec.name + "': empty file (no header line)");
+  const std::vector<std::string_view> header = cells(line);
+  const auto column = [&](const std::string& name) -> std::size_t {
+    for (std::size_t i = 0; i < header.size(); ++i)
+      if (header[i] == name) return i;
+    std::string have;
+    for (auto h : header) have += (have.empty() ? "" : ", ") + input::printable(h);
+    throw InputError(where + ":1: auxiliary source '" + spec.name + "': no column '" + name + "' in the header (columns: " +
+                     have + ")");
+  };
+  const std::size_t time_col = column(spec.time_column);
+  std::vector<std::size_t> cols;
+  for (const auto& c : spec.channels) cols.push_back(column(c.column));
+
+  AuxiliaryTable t;
+  t.values.resize(spec.channels.size());
+  std::size_t repeated = 0, non_finite = 0;
+  while (next_line(line)) {
+    if (trim(line).empty()) continue;
+    const std::vector<std::string_view> row = cells(line);
+    const std::string at = where + ":" + std::to_string(line_no) + ": ";
+    if (row.size() != header.size())
+      throw InputError(at + std::to_string(row.size()) + " cells, the header has " + std::to_string(header.size()));
+    const auto time = input::parse_finite(row[time_col]);
+    if (!time) throw InputError(at + "time '" + input::printable(row[time_col]) + "' is not a finite number");
+    const double seconds = *time * spec.time_scale;
+    if (!t.time.empty() && seconds < t.time.back())
+      throw InputError(at + "time " + std::to_string(seconds) + " s is before the previous row's " +
+                       std::to_string(t.time.back()) + " s: the rows must be sorted by time");
+    if (!t.time.empty() && seconds == t.time.back()) {
+      ++repeated;
+      continue;
+    }
+    t.time.push_back(seconds);
+    for (std::size_t j = 0; j < cols.size(); ++j) {
+      const std::string_view cell = row[cols[j]];
+      double v = std::numeric_limits<double>::quiet_NaN();
+      if (!cell.empty()) {
+        if (cell == "nan" || cell == "NaN" || cell == "inf" || cell == "-inf") {
+          ++non_finite;
+        } else if (const auto x = input::parse_finite(cell)) {
+          v = *x;
+        } else {
+          throw InputError(at + "column '" + spec.channels[j].column + "': '" + input::printable(cell) +
+                           "' is not a number");
+        }
+      }
+      t.values[j].push_back(v);
+    }
+  }
+  if (t.time.size() < 2) throw InputError(where + ": auxiliary source '" + spec.name + "': fewer than 2 rows of data");
+  if (repeated > 0)
+    t.warnings.push_back(where + ": " + std::to_string(repeated) + " rows repeating the previous row's time dropped");
+  if (non_finite > 0)
+    t.warnings.push_back(where + ": " + std::to_string(non_finite) + " non-finite values (nan, inf) left out");
+  if (header.size() > cols.size() + 1) {
+    std::set<std::size_t> used(cols.begin(), cols.end());
+    used.insert(time_col);
+    std::string ignored;
+    for (std::size_t i = 0; i < header.size(); ++i)
+      if (!used.count(i)) ignored += (ignored.empty() ? "" : ", ") + input::printable(header[i]);
+    t.unmapped_columns = ignored;
+  }
+  return t;
+}
+
+std::string SourceReport::describe() const {
+  if (file.empty()) return "source '" + name + "': not given for this run (--source " + name + "=FILE): left out";
+  std::string s = "source '" + name + "' (" + file.filename().string() + "): " + std::to_string(samples) +
+                  " samples" + (unmapped_columns.empty() ? "" : " (columns not mapped: " + unmapped_columns + ")") +
+                  ", clock offset " + fmt(offset) + " s";
+  if (estimate)
+    s += " +- " + fmt(estimate->std).substr(1) + " s (bus time = source time + offset; estimated, peak correlation " +
+         fmt(estimate->correlation, 2).substr(1) + " at " + fmt(estimate->whole_run) + " s over the whole run, median of " +
+         std::to_string(estimate->pieces) + " pieces; " + drift_text(*estimate) + ")";
+  else
+    s += " (fixed in the profile)";
+  return s;
+}
+
+namespace {
+
+std::size_t bus_channel(const VehicleProfile& p, const std::string& name) {
+  for (std::size_t c = 0; c < p.channels.size(); ++c)
+    if (p.channels[c].channel == name && !p.channels[c].source) return c;
+  throw InputError("no bus channel '" + name + "'");
+}
+
+// The bus channels the estimates need, decoded from the whole log (one pass).
+std::map<std::size_t, TimeSeries> bus_series(const VehicleProfile& p, FrameSource& bus, const std::set<std::size_t>& wanted) {
+  std::map<std::size_t, TimeSeries> out;
+  SignalMapper mapper(p);
+  std::vector<ChannelSample> samples;
+  can::Frame frame;
+  while (bus.next(frame, std::chrono::milliseconds(0)) == NextStatus::Frame) {
+    samples.clear();
+    mapper.map(frame, samples);
+    for (const auto& s : samples) {
+      if (!wanted.count(s.channel)) continue;
+      TimeSeries& ts = out[s.channel];
+      if (!ts.t.empty() && !(s.time > ts.t.back())) continue;  // out of order, as the resampler drops it
+      ts.t.push_back(s.time);
+      ts.v.push_back(s.value);
+    }
+  }
+  return out;
+}
+
+ChannelMapping source_mapping(const AuxiliarySourceSpec& spec, std::size_t si, std::size_t ci) {
+  const SourceChannel& c = spec.channels[ci];
+  ChannelMapping m;
+  m.channel = c.channel;
+  m.unit = c.unit;
+  m.message = spec.name + "." + c.column;
+  m.max_gap = c.max_gap;
+  m.gain = c.gain;
+  m.source = si;
+  m.source_channel = ci;
+  return m;
+}
+
+}  // namespace
+
+namespace {
+
+// The source's channels as series on its own clock, in SI: a CSV file's columns, or the
+// channels a second bus's log gives through its DBC.
+std::vector<TimeSeries> read_source(const AuxiliarySourceSpec& spec, SourceReport& report) {
+  std::vector<TimeSeries> series(spec.channels.size());
+  if (spec.type == "csv") {
+    const AuxiliaryTable table = read_auxiliary_csv(spec, report.file);
+    report.warnings = table.warnings;
+    report.unmapped_columns = table.unmapped_columns;
+    for (std::size_t ci = 0; ci < spec.channels.size(); ++ci)
+      for (std::size_t i = 0; i < table.time.size(); ++i) {
+        const double v = table.values[ci][i];
+        if (!std::isfinite(v)) continue;
+        series[ci].t.push_back(table.time[i]);
+        series[ci].v.push_back(spec.channels[ci].gain * spec.channels[ci].to_si.apply(v));
+      }
+    return series;
+  }
+  LogSource log(report.file);
+  SignalMapper mapper(*spec.bus);
+  std::vector<ChannelSample> samples;
+  can::Frame frame;
+  std::uint64_t out_of_order = 0;
+  while (log.next(frame, std::chrono::milliseconds(0)) == NextStatus::Frame) {
+    samples.clear();
+    mapper.map(frame, samples);
+    for (const auto& x : samples) {
+      TimeSeries& ts = series[x.channel];
+      if (!ts.t.empty() && !(x.time > ts.t.back())) {
+        ++out_of_order;
+        continue;
+      }
+      ts.t.push_back(x.time);
+      ts.v.push_back(x.value);
+    }
+  }
+  if (mapper.stats().mapped == 0)
+    throw InputError(report.file.string() + ": source '" + spec.name + "': none of its " +
+                     std::to_string(mapper.stats().frames) + " frames gives a channel of the source (" +
+                     std::to_string(log.bad_input()) + " bad lines or objects)");
+  if (log.bad_input() > 0)
+    report.warnings.push_back(std::to_string(log.bad_input()) + " bad lines or objects skipped; first: " + log.errors().front());
+  if (out_of_order > 0)
+    report.warnings.push_back(std::to_string(out_of_order) + " samples not after their channel's previous one dropped");
+  return series;
+}
+
+}  // namespace
+
+RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::string, std::filesystem::path>& given,
+                           FrameSource* bus) {
+  for (const auto& [name, path] : given) {
+    bool known = false;
+    std::string names;
+    for (const auto& s : declared.sources) known = known || s.name == name, names += (names.empty() ? "" : ", ") + s.name;
+    if (!known)
+      throw InputError("--source " + input::printable(name) + "=" + path.string() + ": the profile " +
+                       declared.source.filename().string() + " declares no source '" + input::printable(name) +
+                       "' (declared: " + (names.empty() ? "none" : names) + ")");
+  }
+  RunSources run{declared, {}, {}};
+  std::vector<std::vector<TimeSeries>> series(declared.sources.size());
+  std::set<std::size_t> wanted;
+  for (std::size_t si = 0; si < declared.sources.size(); ++si) {
+    const AuxiliarySourceSpec& spec = declared.sources[si];
+    SourceReport report;
+    report.name = spec.name;
+    const auto it = given.find(spec.name);
+    report.file = it != given.end() ? it->second : spec.file;
+    if (!report.file.empty()) {
+      series[si] = read_source(spec, report);
+      if (spec.clock.offset) {
+        report.offset = *spec.clock.offset;
+      } else {
+        if (bus == nullptr)
+          throw InputError("source '" + spec.name + "': its clock offset is estimated from the replayed log; a live run "
+                           "has none before it starts: give clock = { offset = <seconds> } in the profile");
+        wanted.insert(bus_channel(declared, spec.clock.reference));
+      }
+      // Its channels: in place of the bus channels they replace, else after the bus channels.
+      for (std::size_t ci = 0; ci < spec.channels.size(); ++ci) {
+        ChannelMapping m = source_mapping(spec, si, ci);
+        if (spec.channels[ci].replaces_bus) run.profile.channels[bus_channel(run.profile, m.channel)] = std::move(m);
+        else run.profile.channels.push_back(std::move(m));
+      }
+    }
+    run.reports.push_back(std::move(report));
+  }
+  std::map<std::size_t, TimeSeries> reference;
+  if (!wanted.empty()) reference = bus_series(declared, *bus, wanted);
+  for (std::size_t si = 0; si < declared.sources.size(); ++si) {
+    const AuxiliarySourceSpec& spec = declared.sources[si];
+    SourceReport& report = run.reports[si];
+    if (report.file.empty()) continue;
+    if (!spec.clock.offset) {
+      std::size_t from = 0;
+      while (spec.channels[from].channel != spec.clock.estimate_from) ++from;
+      ClockOffsetOptions o;
+      o.max_offset = spec.clock.max_offset;
+      o.reference_derivative = spec.clock.reference_derivative;
+      const std::string what = "source '" + spec.name + "' (" + report.file.string() + "): clock from " +
+                               spec.clock.estimate_from + " against the bus's " + spec.clock.reference +
+                               (o.reference_derivative ? " (its derivative)" : "");
+      const ClockEstimate e =
+          estimate_clock_offset(reference[bus_channel(declared, spec.clock.reference)], series[si][from], o, what);
+      if (e.drifting())
+        throw InputError(what + ": the clock drifts: " + drift_text(e) +
+                         ": one offset cannot align it; put the source on the bus's clock first, "
+                         "or give clock = { offset = ... } to accept it");
+      report.estimate = e;
+      report.offset = e.offset;
+    }
+    std::vector<std::size_t> column_of(spec.channels.size());
+    for (std::size_t c = 0; c < run.profile.channels.size(); ++c)
+      if (run.profile.channels[c].source == si) column_of[run.profile.channels[c].source_channel] = c;
+    for (std::size_t ci = 0; ci < spec.channels.size(); ++ci)
+      for (std::size_t i = 0; i < series[si][ci].t.size(); ++i) {
+        run.samples.push_back({series[si][ci].t[i] + report.offset, column_of[ci], series[si][ci].v[i]});
+        ++report.samples;
+      }
+  }
+  std::stable_sort(run.samples.begin(), run.samples.end(),
+                   [](const AuxiliarySample& a, const AuxiliarySample& b) { return a.time < b.time; });
+  return run;
+}
+
+}  // namespace dynid::car
