@@ -223,37 +223,60 @@ std::vector<std::string> sensors_of(const CandidateScore& c, const std::vector<m
   return {};
 }
 
-// The group whose residual `c` takes below the floor, or nullptr.
-const GroupFloor* below_floor(const CandidateScore& c, const NoiseFloor& floor) {
-  const double kept = (1.0 - c.in_sample_drop) * (1.0 - c.in_sample_drop);
+// What the floor of a candidate's model needs.
+struct FloorInputs {
+  const model::Model& model;
+  const std::vector<std::string>& declared;
+  const ingest::RecordedRun& run;
+  const std::vector<ingest::PreprocessedSegment>& segments;
+  const std::vector<ChannelNoise>& noise;
+  const NoiseFloorOptions& options;
+};
+
+// Why `c` fits noise rather than structure, or empty: with it, the residual falls below the
+// noise floor of the model it makes. The floor is the extended model's own, not the declared
+// one's: a candidate that reads a better sensor of a declared signal (the accelerometer for the
+// differentiated wheel speed) lowers the floor too, so on a graded road, where the accelerometer
+// also carries the grade, its residual stays at its own floor and it is accepted (bench/trace:
+// judged against the declared floor it was refused on every graded run).
+std::string below_own_floor(const CandidateScore& c, const FloorInputs& in) {
+  std::vector<std::string> effects = in.declared;
+  effects.push_back(c.effect);
+  NoiseFloor floor;
+  try {
+    floor = noise_floor(in.model, effects, in.run, in.segments, in.noise, in.options);
+  } catch (const InputError&) {
+    return {};  // the extended model's floor cannot be computed: the candidate is not refused
+  }
   for (const GroupFloor& g : floor.groups)
-    if (g.rows > 0 && g.ratio * kept < lowest_ratio(g, floor.groups.size())) return &g;
-  return nullptr;
+    if (g.rows > 0 && g.ratio < lowest_ratio(g, floor.groups.size()))
+      return "takes the " + g.group + " residual below the noise floor of the model it makes" +
+             format(" (ratio of squares %.2g, at least %.2g expected)", g.ratio, lowest_ratio(g, floor.groups.size())) +
+             ": it fits the noise of a declared signal (a better sensor of it), not a missing effect";
+  return {};
 }
 
 // Among the significant candidates, those that take the residual below the floor are refused,
 // and with them every candidate that reads the same sensor (a lag of the accelerometer is the
 // accelerometer, a little worse: measured on bench/trace, it won every run with vx late); the
 // one-standard-error rule then picks among the rest.
-void accept_best(Diagnosis& d, const model::Model& model) {
-  const std::vector<model::Effect> effects = model.candidate_effects();
+void accept_best(Diagnosis& d, const FloorInputs& in) {
+  const std::vector<model::Effect> effects = in.model.candidate_effects();
   std::vector<std::string> refused_sensors;
   std::vector<CandidateScore> eligible;
   for (const CandidateScore& c : d.screen.candidates) {
     if (!c.significant) break;  // ranked: the significant ones come first
+    // Past the first eligible one, only an earlier kind can move ahead of it (the one-error rule):
+    // the others need no floor of their own.
+    if (!eligible.empty() && static_cast<int>(c.kind) >= static_cast<int>(eligible.front().kind)) continue;
     const std::vector<std::string> sensors = sensors_of(c, effects);
     const auto same = std::find_first_of(sensors.begin(), sensors.end(), refused_sensors.begin(), refused_sensors.end());
     if (same != sensors.end()) {
       d.refused.push_back({c.effect, "reads " + *same + ", the sensor refused above as a better sensor of a declared signal"});
       continue;
     }
-    if (const GroupFloor* under = below_floor(c, d.floor)) {
-      const double kept = (1.0 - c.in_sample_drop) * (1.0 - c.in_sample_drop);
-      d.refused.push_back({c.effect, "takes the " + under->group + " residual below the noise floor" +
-                                         format(" (ratio of squares %.2g, at least %.2g expected)", under->ratio * kept,
-                                                lowest_ratio(*under, d.floor.groups.size())) +
-                                         ": it fits the noise of a declared signal (a better sensor of it), "
-                                         "not a missing effect"});
+    if (std::string why = below_own_floor(c, in); !why.empty()) {
+      d.refused.push_back({c.effect, std::move(why)});
       refused_sensors.insert(refused_sensors.end(), sensors.begin(), sensors.end());
       continue;
     }
@@ -358,14 +381,14 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
   }
   NoiseFloorOptions floor_options = options.floor;
   floor_options.fit = options.screen.fit;
-  d.floor = noise_floor(model, declared, run, segments,
-                        measure_channel_noise(run, segments, options.declared_noise), floor_options);
+  const std::vector<ChannelNoise> noise = measure_channel_noise(run, segments, options.declared_noise);
+  d.floor = noise_floor(model, declared, run, segments, noise, floor_options);
   if (d.floor.adequate()) {
     d.verdict = Verdict::kAdequate;
     d.inseparable = inseparable_effects(model, d.screen);
     return d;
   }
-  accept_best(d, model);
+  accept_best(d, {model, declared, run, segments, noise, floor_options});
   d.inseparable = inseparable_effects(model, d.screen, d.accepted ? d.accepted->effect : "");
   d.verdict = d.accepted ? Verdict::kExplained : Verdict::kStructureLeft;
   const SignatureInputs in{model, segments, d.screen.fit, d.floor, rate, odmf,
