@@ -24,6 +24,9 @@ dynid_wire_ParameterStatus to_wire_status(ls::ParameterStatus status) {
     case ls::ParameterStatus::kRegrouped: return dynid_wire_REGROUPED;
     case ls::ParameterStatus::kDependent: return dynid_wire_DEPENDENT;
     case ls::ParameterStatus::kEliminated: return dynid_wire_ELIMINATED;
+    case ls::ParameterStatus::kPoorlyIdentified: return dynid_wire_POORLY_IDENTIFIED;
+    case ls::ParameterStatus::kNotExcited: return dynid_wire_NOT_EXCITED;
+    case ls::ParameterStatus::kImplausible: return dynid_wire_IMPLAUSIBLE;
   }
   throw InputError("Estimate: unknown parameter status");
 }
@@ -43,6 +46,9 @@ ls::ParameterStatus parameter_status_from_wire(long long raw, const std::string&
   if (raw == dynid_wire_REGROUPED) return ls::ParameterStatus::kRegrouped;
   if (raw == dynid_wire_DEPENDENT) return ls::ParameterStatus::kDependent;
   if (raw == dynid_wire_ELIMINATED) return ls::ParameterStatus::kEliminated;
+  if (raw == dynid_wire_POORLY_IDENTIFIED) return ls::ParameterStatus::kPoorlyIdentified;
+  if (raw == dynid_wire_NOT_EXCITED) return ls::ParameterStatus::kNotExcited;
+  if (raw == dynid_wire_IMPLAUSIBLE) return ls::ParameterStatus::kImplausible;
   throw InputError(where + ": unknown status " + std::to_string(raw));
 }
 
@@ -79,6 +85,7 @@ void put_parameter(dynid_wire_ParameterRow& out, const ParameterEntry& entry,
   out.relative_std_percent = entry.relative_std_percent;
   out.status = to_wire_status(entry.status);
   put_text(out.relation, entry.relation);
+  put_text(out.reason, entry.reason);
 }
 
 ParameterEntry get_parameter(const dynid_wire_ParameterRow& in, const std::string& where) {
@@ -91,6 +98,7 @@ ParameterEntry get_parameter(const dynid_wire_ParameterRow& in, const std::strin
   entry.relative_std_percent = in.relative_std_percent;
   entry.status = parameter_status_from_wire(wire_enum_value(in.status), at);
   entry.relation = get(in.relation, at + " relation");
+  entry.reason = get(in.reason, at + " reason");
   return entry;
 }
 
@@ -153,6 +161,7 @@ Sample<dynid_wire_Estimate> to_wire(const EstimateTable& table) {
     groups[k].rows = table.groups[k].rows;
     groups[k].residual_rms = table.groups[k].residual_rms;
   }
+  put_text(out.not_excited, table.not_excited);
   return sample;
 }
 
@@ -173,6 +182,7 @@ EstimateTable from_wire(const dynid_wire_Estimate& sample) {
   table.relative_residual_norm = sample.relative_residual_norm;
   for (const auto& group : elements(sample.groups, dynid_wire_kMaxGroups, where + " groups"))
     table.groups.push_back({get(group.group, where + " group name"), group.rows, group.residual_rms});
+  table.not_excited = get(sample.not_excited, where + " not_excited");
   return table;
 }
 
