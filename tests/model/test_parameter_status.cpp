@@ -122,7 +122,7 @@ TEST(ParameterStatus, OutsideTheBoundsByMoreThanTwoStdIsImplausible) {
   c.add(info("mass", 1500.0, "d_vx"), 1480.0, 3.0, 1.0);
   const auto v = c.classify();
   EXPECT_EQ(v.parameters[0].status, ParameterStatus::kImplausible);
-  EXPECT_NE(v.parameters[0].reason.find("outside its bounds > 0 by 22.3 std"), std::string::npos)
+  EXPECT_NE(v.parameters[0].reason.find("outside its bounds > 0 by 22.33 std"), std::string::npos)
       << v.parameters[0].reason;
   EXPECT_NE(v.parameters[1].status, ParameterStatus::kImplausible) << v.parameters[1].reason;
   EXPECT_EQ(v.parameters[1].status, ParameterStatus::kPoorlyIdentified);  // 75 %

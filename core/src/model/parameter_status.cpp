@@ -10,10 +10,10 @@
 namespace dynid::model {
 namespace {
 
-// Three significant digits for reasons read by people.
+// Four significant digits for reasons read by people (1500 kg, not 1.5e+03).
 std::string short_number(double x) {
   std::ostringstream s;
-  s.precision(3);
+  s.precision(4);
   s << x;
   return s.str();
 }
