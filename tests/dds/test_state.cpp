@@ -145,9 +145,14 @@ TEST(DdsState, ParameterStatusesReasonsAndTheModelNoteCrossTheWire) {
     EXPECT_EQ(back.parameters[0].reason, "not excited: needs d_engine_speed (launches)");
     EXPECT_EQ(back.not_excited, "needs d_engine_speed (launches)");
   }
-  // The first four keep the numbers an older peer knows.
-  EXPECT_EQ(static_cast<int>(dynid_wire_ELIMINATED), 3);
-  EXPECT_EQ(static_cast<int>(dynid_wire_IMPLAUSIBLE), 6);
+  // The refined statuses travel as IDENTIFIED plus a verdict: a reader of the first release's
+  // types (ParameterStatus unchanged) still reads them, as identified.
+  t.parameters[0].status = ls::ParameterStatus::kNotExcited;
+  const auto sample = to_wire(t);
+  EXPECT_EQ(sample.data.parameters._buffer[0].status, dynid_wire_IDENTIFIED);
+  EXPECT_EQ(sample.data.parameters._buffer[0].verdict, dynid_wire_NOT_EXCITED);
+  t.parameters[0].status = ls::ParameterStatus::kRegrouped;
+  EXPECT_EQ(to_wire(t).data.parameters._buffer[0].verdict, dynid_wire_NO_VERDICT);
   EXPECT_THROW(apply_verdict(t, model::ModelVerdict{}), InputError);
 }
 
