@@ -1,6 +1,6 @@
-// What the dynid CLI prints for people and tools, without DDS (issue 16, item 6): the compact
+// What the dynid CLI prints for people and tools, without DDS (issue 16, items 1 and 6): the compact
 // view of `dynid watch --model` (how a value moved, the in-place redraw, JSON lines) and
-// `dynid status` as text.
+// `dynid status` as text, and the estimate table of a model the run does not excite.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,6 +8,7 @@
 
 #include "dynid/cli/shard_replies.hpp"
 #include "dynid/cli/watch_view.hpp"
+#include "dynid/report/estimate_report.hpp"
 
 namespace dynid::test {
 namespace {
@@ -75,6 +76,25 @@ TEST(WatchView, JsonLinesCarryTheStatusAndTheMove) {
   EXPECT_DOUBLE_EQ(b["parameters"][0]["change"].get<double>(), -20.0);
   EXPECT_DOUBLE_EQ(b["parameters"][0]["change_in_std"].get<double>(), -4.0);
   EXPECT_EQ(b["not_excited"], "");
+}
+
+// `dynid estimates` (and every table of the server's replies) prints the same one line.
+TEST(EstimateText, AModelTheRunDoesNotExciteIsOneLineAndItsJsonKeepsTheNumbers) {
+  auto t = table(3, 160.0, 24.0);
+  t.not_excited = "needs d_vx (accelerate, brake)";
+  const std::string text = report::format_estimate_text(t);
+  EXPECT_EQ(cli::line_count(text), 2u) << text;
+  EXPECT_NE(text.find("  not excited by this run: needs d_vx (accelerate, brake) (300 rows; --json has the numbers)"),
+            std::string::npos) << text;
+  const auto json = nlohmann::json::parse(report::estimate_json(t));
+  EXPECT_EQ(json["not_excited"], "needs d_vx (accelerate, brake)");
+  EXPECT_DOUBLE_EQ(json["parameters"][0]["value"].get<double>(), 160.0);
+  EXPECT_EQ(json["parameters"][1]["status"], "not excited");
+
+  t.not_excited.clear();
+  const std::string table_text = report::format_estimate_text(t);
+  EXPECT_NE(table_text.find("not excited        not excited: std 0.96 m^2 >= 0.7 m^2"), std::string::npos)
+      << table_text;  // status, then its reason
 }
 
 dds::Reply status_reply(std::uint32_t shard, std::uint32_t count, const std::string& payload) {
