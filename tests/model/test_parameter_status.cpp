@@ -61,20 +61,25 @@ TEST(ParameterStatus, WellDeterminedParametersAreIdentified) {
   EXPECT_EQ(v.not_excited, "");
 }
 
-TEST(ParameterStatus, ATermBelowTheResidualIsNotExcitedWhateverItsStd) {
-  // A sensor scale of 0.107 with a 1 % std: its column (norm 5) times its a priori 1 is half
-  // the residual: errors in variables, not an estimate.
+TEST(ParameterStatus, ATermBelowTheResidualAndAValueWithin2StdOfZeroIsNotExcited) {
+  // A grade mass on a flat road: its column (norm 5e-3) times 1500 kg is 0.75 of the residual,
+  // and -54 +- 88 kg cannot be told from zero.
   Case c;
-  auto scale = info("sensor_scale", std::nullopt, "d_vx (accelerate, brake)");
-  scale.a_priori = 1.0;
-  c.add(scale, 0.107, 0.001, 5.0);
+  c.add(info("grade_mass", 1500.0, "road_grade (a hilly road)"), -54.0, 88.0, 5e-3);
   c.add(info("mass", 1500.0, "d_vx"), 1480.0, 3.0, 1.0);
-  const auto v = c.classify();
+  auto v = c.classify();
   EXPECT_EQ(v.parameters[0].status, ParameterStatus::kNotExcited);
-  EXPECT_NE(v.parameters[0].reason.find("of the residual"), std::string::npos) << v.parameters[0].reason;
-  EXPECT_NE(v.parameters[0].reason.find("needs d_vx (accelerate, brake)"), std::string::npos) << v.parameters[0].reason;
+  EXPECT_NE(v.parameters[0].reason.find("0.75 of the residual and it is within 2 std of 0"), std::string::npos)
+      << v.parameters[0].reason;
+  EXPECT_NE(v.parameters[0].reason.find("needs road_grade (a hilly road)"), std::string::npos) << v.parameters[0].reason;
   EXPECT_EQ(v.parameters[1].status, ParameterStatus::kIdentified);
   EXPECT_EQ(v.not_excited, "");  // the model is excited: mass is identified
+  // 2 std or more from zero is information, however small the term (the residual may be model
+  // error): then DYCARO's rule decides.
+  c.estimate.value(0) = -200.0;
+  c.estimate.relative_std_percent(0) = 44.0;
+  v = c.classify();
+  EXPECT_EQ(v.parameters[0].status, ParameterStatus::kPoorlyIdentified) << v.parameters[0].reason;
 }
 
 TEST(ParameterStatus, AStdAsLargeAsTheTypicalMagnitudeIsNotExcited) {

@@ -73,10 +73,11 @@ ModelVerdict classify_parameters(const std::vector<ParameterInfo>& parameters,
     const double value = estimate.value(k), sigma = estimate.standard_deviation(k);
     if (const auto scale = excitation_scale(p)) {
       const double term = norms(k) * *scale;
-      if (std::isfinite(residual) && term < residual) {
+      if (std::isfinite(residual) && term < residual && !(std::abs(value) >= 2.0 * sigma)) {
         v.status = ls::ParameterStatus::kNotExcited;
         v.reason = "not excited: at " + with_unit(*scale, p.unit) + " its term is " +
-                   short_number(term / residual) + " of the residual; needs " + needs(p);
+                   short_number(term / residual) + " of the residual and it is within 2 std of 0; needs " +
+                   needs(p);
         continue;
       }
       if (!(sigma < *scale)) {  // NaN std: no information either

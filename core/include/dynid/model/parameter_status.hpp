@@ -15,10 +15,12 @@
 //    its excitation scale s (excitation_scale(): |a priori| when not zero, else the declared
 //    typical magnitude, else the width of a finite bound interval; without a scale this rule is
 //    not applied). Either
-//    a. the term it puts in the equations at magnitude s is below the residual:
-//       ||W(:, j)|| s < ||Y - W X||. The signal its column reads does not move beyond the noise;
-//       what the fit finds is then the attenuation bias of a regressor made of noise (errors in
-//       variables: a sensor scale of 0.1 with a small std), whatever its std says; or
+//    a. the term it puts in the equations at magnitude s is below the residual,
+//       ||W(:, j)|| s < ||Y - W X||, and the estimate is within 2 std of zero: the signal its
+//       column reads does not move beyond what the model leaves unexplained, and the run cannot
+//       tell the parameter from zero (a road-grade mass on a flat road). A value 2 std or more
+//       from zero is information, however small its term: the residual may be model error (a
+//       drag area under a missing road grade reads "poorly identified", not "not excited"); or
 //    b. its standard deviation is at least s: the run cannot tell the parameter's typical
 //       magnitude from zero (its column moves, but only together with others: drag and rolling
 //       resistance at constant speed).
