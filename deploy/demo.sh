@@ -102,8 +102,9 @@ printf '  %-58s %12s\n' \
   "suspension_fl/fr damping (N s/m)" "$(truth suspension.fl damping)" \
   "suspension_rl/rr damping (N s/m)" "$(truth suspension.rl damping)" \
   "tyre_* vertical_stiffness (N/m)" "$(truth suspension.fl tyre_vertical_stiffness)"
-echo "  (the longitudinal and clutch models are not excited by a sine steer at constant speed: their"
-echo "  numbers above are what such a run can say, not estimates; see docs/ACCURACY.md)"
+echo "  (a sine steer at constant speed does not excite the longitudinal and clutch models: their"
+echo "  tables above say so parameter by parameter (not excited, poorly identified; docs/DESIGN.md"
+echo "  \"Parameter status\"); their numbers are what such a run can say, not estimates)"
 
 step "closing the loop: a run with an effect its model does not declare"
 # The same car accelerating on a hilly road; the longitudinal model is asked as if the engineer

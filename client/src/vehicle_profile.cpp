@@ -464,6 +464,41 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
   }
 }
 
+// Optional; absent keys keep the server's defaults (ingest::Preprocessing: DYCARO's).
+void read_preprocessing(const Reader& r, const toml::table& root, VehicleProfile& p) {
+  if (!root.contains("preprocessing")) return;
+  const toml::table& t = r.table(root, "preprocessing");
+  r.only_keys(t, {"butterworth_order", "cut_off_hz", "odmf", "noise"}, "preprocessing.");
+  ingest::Preprocessing& out = p.preprocessing;
+  const auto integer = [&](const char* key, std::int64_t lowest, std::int64_t highest) {
+    const toml::node* n = t.get(key);
+    const std::string full = std::string("preprocessing.") + key;
+    if (!n->is_integer()) r.fail(full, "expected an integer", n);
+    const auto v = *n->value<std::int64_t>();
+    if (v < lowest || v > highest)
+      r.fail(full, "must be within " + std::to_string(lowest) + ".." + std::to_string(highest), n);
+    return static_cast<int>(v);
+  };
+  if (t.contains("butterworth_order")) out.butterworth_order = integer("butterworth_order", 1, 8);
+  if (t.contains("odmf")) out.odmf = integer("odmf", 1, 1000);
+  if (t.contains("cut_off_hz")) {
+    out.cutoff_hz = r.positive(t, "cut_off_hz", "preprocessing.cut_off_hz");
+    if (out.cutoff_hz >= 0.5 * p.rate_hz)
+      r.fail("preprocessing.cut_off_hz", "must be below the grid's Nyquist frequency " +
+                                             std::to_string(0.5 * p.rate_hz) + " Hz", t.get("cut_off_hz"));
+  }
+  if (!t.contains("noise")) return;
+  const toml::table& noise = r.table(t, "noise", "preprocessing.");
+  for (const auto& [key, node] : noise) {
+    const std::string channel(key.str());
+    const std::string full = "preprocessing.noise." + channel;
+    bool mapped = false;
+    for (const auto& c : p.channels) mapped = mapped || c.channel == channel;
+    if (!mapped) r.fail(full, "'" + channel + "' is not a channel of this profile", &node);
+    out.channel_noise[channel] = r.positive(noise, channel, full);
+  }
+}
+
 }  // namespace
 
 double ChannelMapping::value(const std::vector<double>& physical_by_signal) const {
@@ -487,6 +522,7 @@ ingest::RunAnnouncement VehicleProfile::announcement(const std::string& run) con
   a.sample_rate_hz = rate_hz;
   for (const auto& c : channels) a.channels.push_back({c.channel, c.unit});
   a.models = models;
+  a.preprocessing = preprocessing;
   return a;
 }
 
@@ -501,7 +537,7 @@ VehicleProfile parse_vehicle_profile(std::string_view text, const std::filesyste
         << ": TOML syntax: " << e.description();
     throw InputError(msg.str());
   }
-  r.only_keys(root, {"vehicle", "grid", "spool", "constants", "models", "channels", "sources"}, "");
+  r.only_keys(root, {"vehicle", "grid", "spool", "constants", "models", "channels", "sources", "preprocessing"}, "");
   VehicleProfile p;
   p.source = source;
   read_vehicle(r, root, p);
@@ -511,6 +547,7 @@ VehicleProfile parse_vehicle_profile(std::string_view text, const std::filesyste
   read_models(r, root, p);
   read_channels(r, root, p);
   read_sources(r, root, p);
+  read_preprocessing(r, root, p);
   return p;
 }
 

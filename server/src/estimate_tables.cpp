@@ -17,6 +17,8 @@ dds::EstimateTable table_of(const std::string& vehicle, const std::string& sourc
   dds::EstimateTable table =
       dds::make_estimate_table(vehicle, model, source, names, units, estimate.estimate);
   for (const auto& g : estimate.groups) table.groups.push_back({g.name, g.rows, g.residual_rms});
+  dds::apply_verdict(table, model::classify_parameters(parameters, estimate.estimate,
+                                                       model::column_norms(estimate.weighted)));
   return table;
 }
 

@@ -91,11 +91,13 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
     residual::TraceOptions options;
     options.max_rounds = request.rounds;
     options.reference = request.reference;
+    options.diagnosis.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
     return trace_reply(residual::trace(*model, declared, run, options), title, request.format);
   }
   if (request.effect.empty()) {
     residual::DiagnosisOptions options;
     options.screen.only = request.candidates;
+    options.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
     return diagnosis_reply(residual::diagnose(*model, declared, run, segments, options), title, request.format);
   }
   const residual::EffectComparison cmp =

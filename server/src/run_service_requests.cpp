@@ -70,10 +70,6 @@ MergedModel merge_runs(const std::vector<const ingest::RunProcessor*>& processor
   return std::move(*pool);
 }
 
-std::string optional_mark(const std::optional<std::uint64_t>& mark) {
-  return mark ? std::to_string(*mark) : std::string("-");
-}
-
 }  // namespace
 
 std::string RunService::latest_run(const std::string& vehicle) {
@@ -244,20 +240,33 @@ std::string RunService::list_runs(const std::string& vehicle, bool json) {
   settle();  // the chunks received before this request count, the ledger up to date
   latest_run(vehicle);  // NotFound for an unknown vehicle or one without runs
   const auto runs = context_.store.with([&](store::Store& s) { return s.list_runs(vehicle); });
-  std::string text = fmt::format("{:<24} {:<7} {:>10} {:>10} {:>8}\n", "run", "state", "stored", "folded", "chunks");
+  // Text for people: counts of chunks, not the ledger's sequence marks (chunks #0..#39 stored is
+  // "40 in order"); JSON keeps the marks and adds the counts.
+  const auto count = [](const std::optional<std::uint64_t>& mark) { return mark ? *mark + 1 : 0; };
+  std::string text = fmt::format("{:<32} {:<7} {:>8} {:>9} {:>8}  {}\n", "run", "state", "stored",
+                                 "in order", "folded", "complete");
   std::vector<std::string> entries;
   for (const auto& r : runs) {
     const RunState* loaded = find({vehicle, r.run});
     const std::string halted = loaded ? loaded->halted : std::string();
-    text += fmt::format("{:<24} {:<7} {:>10} {:>10} {:>8}{}\n", r.run, r.closed ? "closed" : "open",
-                        optional_mark(r.contiguous_through), optional_mark(r.folded_through),
-                        r.chunks_stored, halted.empty() ? "" : "  " + halted);
+    const std::uint64_t in_order = count(r.contiguous_through), folded = count(r.folded_through);
+    std::string complete;
+    if (!halted.empty()) complete = "no: halted, " + halted;
+    else if (r.chunks_stored > in_order)
+      complete = fmt::format("no: {} stored after a missing chunk #{}", r.chunks_stored - in_order, in_order);
+    else if (folded < in_order) complete = fmt::format("no: {} to fold", in_order - folded);
+    else complete = r.closed ? "yes" : "so far (run open)";
+    text += fmt::format("{:<32} {:<7} {:>8} {:>9} {:>8}  {}\n", r.run, r.closed ? "closed" : "open",
+                        r.chunks_stored, in_order, folded, complete);
     entries.push_back(fmt::format(
         "{{\"run\":{},\"closed\":{},\"contiguous_through\":{},\"folded_through\":{},"
-        "\"chunks_stored\":{},\"halted\":{}}}",
+        "\"chunks_stored\":{},\"chunks_in_order\":{},\"chunks_folded\":{},\"halted\":{}}}",
         json_string(r.run), r.closed, r.contiguous_through ? std::to_string(*r.contiguous_through) : "null",
-        r.folded_through ? std::to_string(*r.folded_through) : "null", r.chunks_stored, json_string(halted)));
+        r.folded_through ? std::to_string(*r.folded_through) : "null", r.chunks_stored, in_order, folded,
+        json_string(halted)));
   }
+  text += "chunks: stored = held by the store; in order = stored without a gap from chunk #0; "
+          "folded = in the estimates\n";
   return json ? "[" + join(entries, ",") + "]" : text;
 }
 

@@ -208,6 +208,39 @@ TEST(CarProfile, ConstantsAndModels) {
   expect_error(replace(kGood, "b = 1.5\n", ""), ":15:", "models[0].name", "'b'");
 }
 
+// Issue 16 item 5: [preprocessing] sets the server's processing per vehicle; absent keys keep
+// today's values (ingest::Preprocessing's defaults), and every run's announcement carries it.
+TEST(CarProfile, PreprocessingPerVehicleWithTodaysDefaults) {
+  const VehicleProfile plain = parse_vehicle_profile(kGood, profile_path("broken.toml"));
+  const ingest::Preprocessing defaults;
+  EXPECT_EQ(plain.preprocessing.butterworth_order, defaults.butterworth_order);
+  EXPECT_EQ(plain.preprocessing.odmf, defaults.odmf);
+  EXPECT_EQ(plain.preprocessing.cutoff_hz, 0.0);
+  EXPECT_TRUE(plain.preprocessing.channel_noise.empty());
+
+  const std::string set = kGood + "[preprocessing]\nbutterworth_order = 4\ncut_off_hz = 6.5\nodmf = 5\n"
+                                  "noise = { vx = 0.02, steer = 0.001 }\n";
+  const VehicleProfile p = parse_vehicle_profile(set, profile_path("broken.toml"));
+  EXPECT_EQ(p.preprocessing.butterworth_order, 4);
+  EXPECT_EQ(p.preprocessing.cutoff_hz, 6.5);
+  EXPECT_EQ(p.preprocessing.odmf, 5);
+  EXPECT_EQ(p.preprocessing.channel_noise.at("steer"), 0.001);
+  const ingest::RunAnnouncement a = p.announcement("run-1");
+  EXPECT_EQ(a.preprocessing.odmf, 5);
+  EXPECT_EQ(a.preprocessing.channel_noise, p.preprocessing.channel_noise);
+  EXPECT_NO_THROW(a.validate());
+
+  const std::string base = kGood + "[preprocessing]\n";
+  expect_error(base + "odmf = 0\n", ":28:", "preprocessing.odmf", "must be within 1..1000");
+  expect_error(base + "odmf = 2.5\n", ":28:", "preprocessing.odmf", "expected an integer");
+  expect_error(base + "butterworth_order = 9\n", ":28:", "preprocessing.butterworth_order", "1..8");
+  expect_error(base + "cut_off_hz = 60.0\n", ":28:", "preprocessing.cut_off_hz", "Nyquist frequency");
+  expect_error(base + "noise = { ax = 0.1 }\n", ":28:", "preprocessing.noise.ax",
+               "'ax' is not a channel of this profile");
+  expect_error(base + "noise = { vx = -0.1 }\n", ":28:", "preprocessing.noise.vx", "must be > 0");
+  expect_error(base + "cutoff = 5.0\n", ":28:", "preprocessing.cutoff", "unknown key");
+}
+
 TEST(CarProfile, SyntaxAndFileErrors) {
   expect_error(replace(kGood, "[grid]", "[grid"), ":5:", "TOML syntax", "");
   expect_error(replace(kGood, "dynid_testcar.dbc", "nope.dbc"), ":4:", "vehicle.dbc",

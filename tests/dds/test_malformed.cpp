@@ -74,6 +74,12 @@ TEST(DdsMalformed, UnknownEnumValues) {
   auto sample = to_wire(t);
   sample.data.parameters._buffer[0].status = static_cast<dynid_wire_ParameterStatus>(9);
   EXPECT_MENTIONS(rejection([&] { from_wire(sample.data); }), "unknown status 9");
+  sample.data.parameters._buffer[0].status = dynid_wire_IDENTIFIED;
+  sample.data.parameters._buffer[0].verdict = static_cast<dynid_wire_ParameterVerdict>(7);
+  EXPECT_MENTIONS(rejection([&] { from_wire(sample.data); }), "unknown verdict 7");
+  sample.data.parameters._buffer[0].status = dynid_wire_DEPENDENT;
+  sample.data.parameters._buffer[0].verdict = dynid_wire_NOT_EXCITED;
+  EXPECT_MENTIONS(rejection([&] { from_wire(sample.data); }), "not identified");
 }
 
 TEST(DdsMalformed, OversizeValuesAreRefusedBeforeTheyReachTheWire) {

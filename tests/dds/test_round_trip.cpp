@@ -40,6 +40,33 @@ TEST(DdsRoundTrip, AnnouncementArrivesUnchanged) {
   }
 }
 
+// Issue 16 item 5: the vehicle's preprocessing crosses the wire; an announcement whose
+// preprocessing member is all zeros (an older car's, which lacks the member) reads as the
+// server's defaults.
+TEST(DdsRoundTrip, PreprocessingCrossesTheWireAndZerosMeanDefaults) {
+  auto sent = make_announcement("proto-17", "run-4");
+  sent.preprocessing.butterworth_order = 3;
+  sent.preprocessing.cutoff_hz = 4.5;
+  sent.preprocessing.odmf = 4;
+  sent.preprocessing.channel_noise = {{sent.channels[0].name, 0.25}};
+  const auto got = from_wire(to_wire(sent).data);
+  EXPECT_EQ(got.preprocessing.butterworth_order, 3);
+  EXPECT_EQ(got.preprocessing.cutoff_hz, 4.5);
+  EXPECT_EQ(got.preprocessing.odmf, 4);
+  EXPECT_EQ(got.preprocessing.channel_noise, sent.preprocessing.channel_noise);
+
+  auto older = to_wire(make_announcement("proto-17", "run-5"));
+  older.data.butterworth_order = 0;
+  older.data.cutoff_hz = 0.0;
+  older.data.odmf = 0;
+  const auto defaults = from_wire(older.data);
+  const ingest::Preprocessing expected;
+  EXPECT_EQ(defaults.preprocessing.butterworth_order, expected.butterworth_order);
+  EXPECT_EQ(defaults.preprocessing.odmf, expected.odmf);
+  EXPECT_EQ(defaults.preprocessing.cutoff_hz, 0.0);
+  EXPECT_NO_THROW(defaults.validate());
+}
+
 TEST(DdsRoundTrip, ChunksArriveBitForBitInOrder) {
   Participant car(loopback_options());
   Participant server(loopback_options());

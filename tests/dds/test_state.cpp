@@ -50,7 +50,7 @@ EstimateTable table(const std::string& vehicle, const std::string& model, std::u
   t.model = model;
   t.source = "run-1";
   t.revision = revision;
-  t.parameters = {{"m", "kg", value, 0.5, 100 * 0.5 / value, ls::ParameterStatus::kIdentified, ""}};
+  t.parameters = {{"m", "kg", value, 0.5, 100 * 0.5 / value, ls::ParameterStatus::kIdentified, "", ""}};
   t.groups = {{"longitudinal", 1000 * revision, 0.01}};
   return t;
 }
@@ -127,6 +127,33 @@ TEST(DdsState, EstimateTableFromARealEstimateCarriesStatusesAndRelations) {
   EXPECT_EQ(back.parameters[2].status, ls::ParameterStatus::kDependent);
   EXPECT_THROW(make_estimate_table("A", "toy", "run-1", {"a", "b"}, {"kg", "N"}, estimate),
                InputError);
+}
+
+TEST(DdsState, ParameterStatusesReasonsAndTheModelNoteCrossTheWire) {
+  // Issue 16: the statuses appended to the wire enum, each parameter's reason and the
+  // model-level "not excited" line arrive as they were sent.
+  EstimateTable t = table("A", "clutch_slip", 1, 0.2);
+  const model::ModelVerdict verdict{
+      {{ls::ParameterStatus::kNotExcited, "not excited: needs d_engine_speed (launches)"}},
+      "needs d_engine_speed (launches)"};
+  apply_verdict(t, verdict);
+  for (const auto status : {ls::ParameterStatus::kPoorlyIdentified, ls::ParameterStatus::kNotExcited,
+                            ls::ParameterStatus::kImplausible, ls::ParameterStatus::kIdentified}) {
+    t.parameters[0].status = status;
+    const auto back = from_wire(to_wire(t).data);
+    EXPECT_EQ(back.parameters[0].status, status);
+    EXPECT_EQ(back.parameters[0].reason, "not excited: needs d_engine_speed (launches)");
+    EXPECT_EQ(back.not_excited, "needs d_engine_speed (launches)");
+  }
+  // The refined statuses travel as IDENTIFIED plus a verdict: a reader of the first release's
+  // types (ParameterStatus unchanged) still reads them, as identified.
+  t.parameters[0].status = ls::ParameterStatus::kNotExcited;
+  const auto sample = to_wire(t);
+  EXPECT_EQ(sample.data.parameters._buffer[0].status, dynid_wire_IDENTIFIED);
+  EXPECT_EQ(sample.data.parameters._buffer[0].verdict, dynid_wire_NOT_EXCITED);
+  t.parameters[0].status = ls::ParameterStatus::kRegrouped;
+  EXPECT_EQ(to_wire(t).data.parameters._buffer[0].verdict, dynid_wire_NO_VERDICT);
+  EXPECT_THROW(apply_verdict(t, model::ModelVerdict{}), InputError);
 }
 
 }  // namespace

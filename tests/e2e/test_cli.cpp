@@ -1,6 +1,10 @@
 // (d) The dynid executable against a running server: `dynid estimates --vehicle V` prints the
 // table (parameter, unit, value, std, relative std %, status; rows, sigma, cond, residual RMS),
 // the other commands answer, and without a server it says so within its timeout.
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+
 #include "e2e_fixture.hpp"
 
 namespace dynid::e2e {
@@ -8,16 +12,28 @@ namespace {
 
 CommandResult dynid(const std::vector<std::string>& arguments) { return run_dynid(arguments); }
 
-TEST(E2eCli, EstimatesTableAgainstRunningServer) {
+// A server on a temporary store that has folded one streamed test run and published its
+// estimates (`ready` false, and the test stops, when they did not come).
+struct ServedRun {
+  ServedRun(const std::string& vehicle, const std::string& run_id, unsigned seed)
+      : server(server_options(dir.file("store.db"))), run(test_run(vehicle, run_id, seed)),
+        chunks(cut_run(run, 8u)), watcher(vehicle) {
+    TestCar car(vehicle);
+    ready = car.stream(run.announcement, chunks) &&
+            watcher.wait_for(references(offline(run, chunks).estimates()), run_id);
+  }
   TempDir dir;
-  InProcessServer server(server_options(dir.file("store.db")));
-  const auto run = test_run("cli-car", "run-c", 41u);
-  const auto chunks = cut_run(run, 8u);
-  TestCar car("cli-car");
-  ASSERT_TRUE(car.stream(run.announcement, chunks));
-  const auto expected = references(offline(run, chunks).estimates());
-  EstimateWatcher watcher("cli-car");
-  ASSERT_TRUE(watcher.wait_for(expected, "run-c"));
+  InProcessServer server;
+  ingest::test::TestRun run;
+  std::vector<ingest::Chunk> chunks;
+  EstimateWatcher watcher;
+  bool ready = false;
+};
+
+TEST(E2eCli, EstimatesTableAgainstRunningServer) {
+  ServedRun served("cli-car", "run-c", 41u);
+  ASSERT_TRUE(served.ready);
+  auto& watcher = served.watcher;
 
   const auto table = dynid({"estimates", "--vehicle", "cli-car"});
   ASSERT_EQ(table.exit_code, 0) << table.err;
@@ -42,6 +58,56 @@ TEST(E2eCli, EstimatesTableAgainstRunningServer) {
   const auto unknown = dynid({"estimates", "--vehicle", "nobody"});
   EXPECT_EQ(unknown.exit_code, 3);
   EXPECT_NE(unknown.err.find("unknown vehicle"), std::string::npos) << unknown.err;
+}
+
+// Issue 16, item 6: what an engineer follows live. `watch --model` shows that model only,
+// compact (appended blocks on a pipe), JSON lines with --json; `status` and `runs` are text
+// with columns that say what they count.
+TEST(E2eCli, WatchOneModelAndTextForPeople) {
+  ServedRun served("watch-car", "run-w", 43u);
+  ASSERT_TRUE(served.ready);
+  const auto& chunks = served.chunks;
+
+  const auto watch = dynid({"watch", "--vehicle", "watch-car", "--model", "longitudinal_wheel", "--seconds", "1.5"});
+  ASSERT_EQ(watch.exit_code, 0) << watch.err;
+  EXPECT_EQ(watch.out.rfind("watch-car / longitudinal_wheel  source run-w, revision ", 0), 0u) << watch.out;
+  for (const std::string word : {"parameter", "value", "std", "rel.std%", "status", "moved since last", "mass"})
+    EXPECT_NE(watch.out.find(word), std::string::npos) << "missing '" << word << "' in\n" << watch.out;
+  EXPECT_EQ(watch.out.find("locked_driveline"), std::string::npos) << watch.out;
+  EXPECT_EQ(watch.out.find('\x1b'), std::string::npos) << "no cursor moves on a pipe";
+
+  const auto lines = dynid({"--json", "watch", "--vehicle", "watch-car", "--model", "locked_driveline", "--seconds", "1.5"});
+  ASSERT_EQ(lines.exit_code, 0) << lines.err;
+  std::istringstream in(lines.out);
+  std::size_t count = 0;
+  for (std::string line; std::getline(in, line); ++count) {
+    const auto sample = nlohmann::json::parse(line);
+    EXPECT_EQ(sample["model"], "locked_driveline") << line;
+    EXPECT_EQ(sample["source"], "run-w") << line;
+    EXPECT_TRUE(sample["parameters"][0].contains("status")) << line;
+  }
+  EXPECT_GE(count, 1u) << lines.out;
+  const auto nothing = dynid({"watch", "--vehicle", "watch-car", "--model", "no_such_model", "--seconds", "1"});
+  EXPECT_EQ(nothing.exit_code, 5);
+  EXPECT_NE(nothing.err.find("no estimate of watch-car model no_such_model"), std::string::npos) << nothing.err;
+
+  const auto status = dynid({"status"});
+  ASSERT_EQ(status.exit_code, 0) << status.err;
+  EXPECT_EQ(status.out.find('{'), std::string::npos) << status.out;
+  const std::string n = std::to_string(chunks.size());
+  EXPECT_TRUE(std::regex_search(status.out, std::regex("chunks stored durably \\(acknowledged\\) +" + n + "\n")))
+      << status.out;
+  const auto raw = dynid({"--json", "status"});
+  EXPECT_EQ(nlohmann::json::parse(raw.out)["chunks_stored"], chunks.size()) << raw.out;
+
+  const auto runs = dynid({"runs", "--vehicle", "watch-car"});
+  ASSERT_EQ(runs.exit_code, 0) << runs.err;
+  EXPECT_TRUE(std::regex_search(runs.out, std::regex("run +state +stored +in order +folded +complete\n"))) << runs.out;
+  EXPECT_TRUE(std::regex_search(runs.out, std::regex("run-w +open +" + n + " +" + n + " +" + n + " +so far \\(run open\\)\n"))) << runs.out;
+  EXPECT_NE(runs.out.find("in order = stored without a gap from chunk #0"), std::string::npos) << runs.out;
+  ASSERT_EQ(dynid({"close", "--vehicle", "watch-car", "--run", "run-w"}).exit_code, 0);
+  const auto closed = dynid({"runs", "--vehicle", "watch-car"});
+  EXPECT_TRUE(std::regex_search(closed.out, std::regex("run-w +closed +" + n + " +" + n + " +" + n + " +yes\n"))) << closed.out;
 }
 
 TEST(E2eCli, SaysSoWhenNoServerAnswers) {

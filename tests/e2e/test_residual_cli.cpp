@@ -123,5 +123,37 @@ TEST(E2eResidualCli, DiagnosesAndTracesInTextAndJson) {
   EXPECT_EQ(c.at("comparisons").front().at("against"), "reference");
 }
 
+// Issue 16: the noise a vehicle profile declares for a sensor ([preprocessing] noise, carried
+// by the announcement) is the one the residual loop's floor uses, and the before/after table
+// gives each parameter's status in both fits.
+TEST(E2eResidualCli, DeclaredNoiseAndParameterStatusesReachTheReports) {
+  TempDir dir;
+  InProcessServer server(server_options(dir.file("store.db")));
+  auto run = test_run("noise-car", "run-n", 45u);
+  run.announcement.preprocessing.channel_noise = {{"ax", 0.0123}};
+  TestCar car("noise-car");
+  ASSERT_TRUE(car.stream(run.announcement, cut_run(run, 9u)));
+  const std::vector<std::string> where{"--vehicle", "noise-car", "--run", "run-n", "--model", "kinematic_longitudinal"};
+
+  std::vector<std::string> args{"residual"};
+  args.insert(args.end(), where.begin(), where.end());
+  const auto screen = dynid(args);
+  ASSERT_EQ(screen.exit_code, 0) << screen.err;
+  EXPECT_NE(screen.out.find("ax 0.0123 (declared)"), std::string::npos) << screen.out;
+
+  args = {"add-effect"};
+  args.insert(args.end(), where.begin(), where.end());
+  args.insert(args.end(), {"--effect", "dict:sq:vx"});
+  const auto text = dynid(args);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("err %  status"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("-> "), std::string::npos) << "the effect's own parameter has no status before\n" << text.out;
+  args.push_back("--json");
+  const auto json = nlohmann::json::parse(dynid(args).out);
+  const auto& first = json.at("parameters").at(0);
+  EXPECT_TRUE(first.at("status_before").is_string()) << first.dump();
+  EXPECT_TRUE(first.at("status_after").is_string()) << first.dump();
+}
+
 }  // namespace
 }  // namespace dynid::e2e

@@ -235,7 +235,7 @@ TEST(E2eShard, TwoServersOwnTheirVehiclesAndOneStoppingDisturbsNotTheOther) {
     EXPECT_EQ(reply.shard, v.owner) << v.id;
     EXPECT_EQ(reply.shard_count, kShards);
   }
-  const auto status = dynid({"status"});
+  const auto status = dynid({"--json", "status"});
   EXPECT_EQ(status.exit_code, 0) << status.err;
   EXPECT_NE(status.out.find("\"shards\":{\"0/2\":{"), std::string::npos) << status.out;
   EXPECT_NE(status.out.find("\"1/2\":{"), std::string::npos) << status.out;

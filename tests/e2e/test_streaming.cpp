@@ -44,5 +44,31 @@ TEST(E2eStreaming, PublishedEstimateEqualsOfflineProcessor) {
   EXPECT_GE(counters.checkpoints, chunks.size() / 4);
 }
 
+// Issue 16 item 5: the vehicle's preprocessing (here odmf 4 and a 6 Hz cut-off instead of the
+// defaults 8 and DYCARO's rule) crosses the wire and is the one the server processes with: its
+// estimates equal an offline processor of the same announcement, row counts included (odmf 4
+// builds about twice the rows of the default).
+TEST(E2eStreaming, TheServerProcessesWithTheAnnouncedPreprocessing) {
+  TempDir dir;
+  InProcessServer server(server_options(dir.file("store.db")));
+  auto run = test_run("prep-car", "run-p", 9u);
+  run.announcement.preprocessing.odmf = 4;
+  run.announcement.preprocessing.cutoff_hz = 6.0;
+  const auto chunks = cut_run(run, 13u);
+  TestCar car("prep-car");
+  EstimateWatcher watcher("prep-car");
+  ASSERT_TRUE(car.stream(run.announcement, chunks));
+  auto processor = offline(run, chunks);
+  const auto expected = references(processor.estimates());
+  ASSERT_TRUE(watcher.wait_for(expected, "run-p")) << "seen " << watcher.seen();
+  for (const auto& e : expected) expect_equal(e, watcher.latest("run-p").at(e.model));
+
+  auto defaults = run;
+  defaults.announcement.preprocessing = {};
+  const auto default_rows = references(offline(defaults, chunks).estimates());
+  ASSERT_EQ(default_rows.size(), expected.size());
+  EXPECT_GT(expected[0].rows, default_rows[0].rows * 3 / 2) << "odmf 4 against 8";
+}
+
 }  // namespace
 }  // namespace dynid::e2e

@@ -78,7 +78,7 @@ TEST_F(FullDisk, UnderTheStoreNothingUnstoredIsAcknowledgedAndTheRunCompletesWhe
   std::cout << "the server said: " << said.substr(0, said.find('\n') + 1);
   EXPECT_NE(said.find(store.string()), std::string::npos) << said;
   EXPECT_TRUE(std::regex_search(said, std::regex("disk (is )?full"))) << said;  // SQLite: "database or disk is full"
-  const std::string status = dynid_cli(scratch.path(), {"status"});
+  const std::string status = dynid_cli(scratch.path(), {"--json", "status"});
   EXPECT_EQ(status.find("\"store_errors\":0"), std::string::npos) << status;
 
   std::this_thread::sleep_for(2s);  // the car resends meanwhile; nothing may be acknowledged

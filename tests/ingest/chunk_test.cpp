@@ -206,5 +206,26 @@ TEST(RunAnnouncement, EncodingRoundTripsAndDetectsCorruption) {
   EXPECT_THROW((void)decode_announcement(bytes.substr(0, bytes.size() - 1)), InputError);
 }
 
+// Issue 16 item 5: the vehicle profile's declared sensor noise rides in the announcement. An
+// announcement without it encodes as before (version 1, so stored announcements and
+// checkpoints still match); with it, as version 2, which this build reads too.
+TEST(RunAnnouncement, DeclaredChannelNoiseIsValidatedAndEncoded) {
+  RunAnnouncement a = test::announcement_for({});
+  const std::string plain = encode_announcement(a);
+  EXPECT_EQ(plain.substr(8, 2), std::string("\x01\x00", 2));  // after the magic: version 1
+  a.preprocessing.channel_noise = {{"vx", 0.02}, {"gear", 0.5}};
+  EXPECT_NO_THROW(a.validate());
+  const std::string bytes = encode_announcement(a);
+  EXPECT_EQ(bytes.substr(8, 2), std::string("\x02\x00", 2));
+  const RunAnnouncement b = decode_announcement(bytes);
+  EXPECT_EQ(b.preprocessing.channel_noise, a.preprocessing.channel_noise);
+  EXPECT_EQ(encode_announcement(b), bytes);
+  EXPECT_TRUE(decode_announcement(plain).preprocessing.channel_noise.empty());
+  a.preprocessing.channel_noise = {{"vy", 0.02}};
+  expect_input_error([&] { a.validate(); }, {"channel_noise 'vy'", "not an announced channel"});
+  a.preprocessing.channel_noise = {{"vx", 0.0}};
+  expect_input_error([&] { a.validate(); }, {"channel_noise 'vx'", "finite std > 0"});
+}
+
 }  // namespace
 }  // namespace dynid::ingest

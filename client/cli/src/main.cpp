@@ -17,11 +17,13 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <unistd.h>
 
 #include <dynid/input/option_checks.hpp>
 
 #include "dynid/cli/request_client.hpp"
 #include "dynid/cli/shard_replies.hpp"
+#include "dynid/cli/watch_view.hpp"
 #include "dynid/dds/conversions.hpp"
 #include "dynid/dds/topics.hpp"
 #include "dynid/report/estimate_report.hpp"
@@ -73,9 +75,10 @@ int request_all(const Common& c, dynid::cli::RequestClient& client, const std::s
   const std::vector<RequestArgument> arguments{{"format", "json"}};
   const auto replies = client.call_all(kind, arguments, timeout_of(c));
   if (const auto failure = replies.failure()) return print(kind, *failure);
-  std::cout << (kind == "status" ? dynid::cli::merged_status(replies)
-                                 : dynid::cli::render_vehicles(dynid::cli::merged_vehicles(replies), c.json));
-  if (kind == "status" || c.json) std::cout << "\n";
+  if (kind == "status")
+    std::cout << (c.json ? dynid::cli::merged_status(replies) + "\n" : dynid::cli::status_text(replies));
+  else
+    std::cout << dynid::cli::render_vehicles(dynid::cli::merged_vehicles(replies), c.json) << (c.json ? "\n" : "");
   const std::string note =
       dynid::cli::missing_note(replies, timeout_of(c).count(), kind == "status" ? "counters" : "vehicles");
   if (note.empty()) return 0;
@@ -109,21 +112,36 @@ int report_request(const Common& c, const std::string& kind, const std::vector<R
   return 0;
 }
 
-int watch(const Common& c, const std::string& vehicle, double seconds) {
+// Without --model: every model's full table (or its JSON) at each publication. With --model:
+// that model only, compact (WatchView): redrawn in place on a terminal, appended blocks on a
+// pipe or file, JSON lines with --json.
+int watch(const Common& c, const std::string& vehicle, const std::string& model, double seconds) {
   dynid::dds::Participant participant({c.domain, dynid::dds::config_uri(c.config)});
   dynid::dds::Reader<dynid_wire_Estimate> reader(participant, {dynid::dds::vehicle_partition(vehicle)});
   const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long long>(seconds * 1000));
+  const bool terminal = isatty(STDOUT_FILENO) == 1;
+  dynid::cli::WatchView view;
   std::size_t shown = 0;
   while (std::chrono::steady_clock::now() < end) {
     for (auto& sample : reader.wait_take(200ms)) {
       const auto table = dynid::dds::from_wire(sample.data);
-      std::cout << (c.json ? dynid::report::estimate_json(table) + "\n"
-                           : dynid::report::format_estimate_text(table) + "\n")
-                << std::flush;
+      if (model.empty()) {
+        std::cout << (c.json ? dynid::report::estimate_json(table) + "\n"
+                             : dynid::report::format_estimate_text(table) + "\n");
+      } else if (table.model != model) {
+        continue;
+      } else if (c.json) {
+        std::cout << view.json_line(table);
+      } else {
+        std::cout << (terminal ? view.redraw(table) : view.text(table) + "\n");
+      }
+      std::cout << std::flush;
       ++shown;
     }
   }
-  if (shown == 0) std::cerr << "dynid watch: no estimate of " << vehicle << " in " << seconds << " s\n";
+  if (shown == 0)
+    std::cerr << "dynid watch: no estimate of " << vehicle << (model.empty() ? "" : " model " + model) << " in "
+              << seconds << " s\n";
   return shown ? 0 : 5;
 }
 
@@ -173,14 +191,18 @@ int main(int argc, char** argv) {
   std::vector<std::string> runs;
   double seconds = 10.0;
   auto* vehicles_cmd = app.add_subcommand("vehicles", "list the vehicles");
-  auto* runs_cmd = app.add_subcommand("runs", "list a vehicle's runs with their ledger marks");
+  auto* runs_cmd = app.add_subcommand("runs", "list a vehicle's runs: chunks stored, in order, folded; complete or not");
   runs_cmd->add_option("--vehicle", vehicle)->required();
   auto* estimates_cmd = app.add_subcommand("estimates", "estimate tables (latest run by default)");
   estimates_cmd->add_option("--vehicle", vehicle)->required();
   estimates_cmd->add_option("--run", run);
   estimates_cmd->add_option("--model", model);
-  auto* watch_cmd = app.add_subcommand("watch", "print estimates as they are published");
+  auto* watch_cmd = app.add_subcommand(
+      "watch", "print estimates as they are published (--model: one model, compact, updated in place)");
   watch_cmd->add_option("--vehicle", vehicle)->required();
+  watch_cmd->add_option("--model", model,
+                        "follow this model: one line per parameter (value, std, status, how it moved); "
+                        "JSON lines with --json");
   watch_cmd->add_option("--seconds", seconds, "how long to watch")
       ->check(dynid::input::within(kMinSeconds, kMaxSeconds));
   auto* pooled_cmd = app.add_subcommand("pooled", "estimate over several runs of a vehicle");
@@ -234,7 +256,7 @@ int main(int argc, char** argv) {
   auto* close_cmd = app.add_subcommand("close", "close a run (final estimates)");
   close_cmd->add_option("--vehicle", vehicle)->required();
   close_cmd->add_option("--run", run)->required();
-  auto* status_cmd = app.add_subcommand("status", "the server's counters");
+  auto* status_cmd = app.add_subcommand("status", "the server's counters, one per line with what it counts (--json: raw)");
   std::vector<std::string> shared;
   std::string fleet_vehicles;
   auto* fleet_cmd = app.add_subcommand(
@@ -266,7 +288,7 @@ int main(int argc, char** argv) {
     if (*runs_cmd) return request(c, "runs", args({{"vehicle", vehicle}}));
     if (*estimates_cmd)
       return request(c, "estimate", args({{"vehicle", vehicle}, {"run", run}, {"model", model}}));
-    if (*watch_cmd) return watch(c, vehicle, seconds);
+    if (*watch_cmd) return watch(c, vehicle, model, seconds);
     if (*pooled_cmd) {
       auto a = args({{"vehicle", vehicle}, {"model", model}});
       for (const auto& r : runs) a.push_back({"run", r});

@@ -86,6 +86,50 @@ std::string merged_status(const ShardReplies& replies) {
   return out.dump();
 }
 
+namespace {
+
+// What each counter of the server's status counts (server/src/counters.cpp names them).
+constexpr std::pair<const char*, const char*> kCounterMeaning[] = {
+    {"announcements", "run announcements accepted"},
+    {"rejected_announcements", "run announcements rejected"},
+    {"chunks_stored", "chunks stored durably (acknowledged)"},
+    {"chunks_duplicate", "chunks received again (already stored)"},
+    {"chunks_rejected", "chunks rejected (bad, state unchanged)"},
+    {"chunks_folded", "chunks folded into estimates"},
+    {"chunks_replayed", "chunks replayed from the store"},
+    {"checkpoints", "accumulator checkpoints saved"},
+    {"estimates_published", "estimates published"},
+    {"requests", "engineer requests received"},
+    {"requests_rejected", "engineer requests refused"},
+    {"not_owned", "samples of other shards' vehicles"},
+    {"store_errors", "store errors"},
+};
+
+std::string counter_lines(const ordered_json& counters, const std::string& indent) {
+  std::string out;
+  for (const auto& [key, value] : counters.items()) {
+    std::string label = key;
+    for (const auto& [name, meaning] : kCounterMeaning)
+      if (key == name) label = meaning;
+    out += indent + label + std::string(label.size() < 42 ? 42 - label.size() : 1, ' ') +
+           (value.is_string() ? value.get<std::string>() : value.dump()) + "\n";
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string status_text(const ShardReplies& replies) {
+  if (replies.count() == 1 && replies.complete())
+    return counter_lines(parse_payload(replies.replies().begin()->second, "status"), "");
+  std::string out;
+  for (const auto& [index, reply] : replies.replies())
+    out += "shard " + name_of(reply) + "\n" + counter_lines(parse_payload(reply, "status"), "  ");
+  for (const auto index : replies.missing())
+    out += "shard " + shard_name(index, replies.count()) + ": did not answer\n";
+  return out;
+}
+
 std::string missing_note(const ShardReplies& replies, std::int64_t timeout_ms, const std::string& what) {
   const auto missing = replies.missing();
   if (missing.empty()) return {};

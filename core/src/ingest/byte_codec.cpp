@@ -81,13 +81,15 @@ std::string_view ByteReader::get_bytes(const char* field) {
   return s;
 }
 
-void ByteReader::expect_header(std::string_view magic, std::uint16_t version) {
+std::uint16_t ByteReader::expect_header(std::string_view magic, std::uint16_t oldest, std::uint16_t newest) {
   if (in_.substr(0, magic.size()) != magic) fail("bad magic (not a " + what_ + ")");
   pos_ = magic.size();
   const auto found = get<std::uint16_t>("version");
-  if (found != version)
+  if (found < oldest || found > newest)
     fail("unsupported format version " + std::to_string(found) + " (this build reads version " +
-         std::to_string(version) + ")");
+         (oldest == newest ? std::to_string(newest) : std::to_string(oldest) + " to " + std::to_string(newest)) +
+         ")");
+  return found;
 }
 
 void ByteReader::verify_checksum() {
@@ -99,9 +101,12 @@ void ByteReader::verify_checksum() {
   in_ = body;
 }
 
-void ByteReader::open(std::string_view magic, std::uint16_t version) {
-  expect_header(magic, version);
+void ByteReader::open(std::string_view magic, std::uint16_t version) { open(magic, version, version); }
+
+std::uint16_t ByteReader::open(std::string_view magic, std::uint16_t oldest, std::uint16_t newest) {
+  const std::uint16_t found = expect_header(magic, oldest, newest);
   verify_checksum();
+  return found;
 }
 
 void ByteReader::expect_end() const {

@@ -64,6 +64,8 @@ class ByteReader {
   /// Checks the magic tag, the version, and that the last 4 bytes are the CRC-32 of the rest
   /// (excluded from reading); throws naming what was found.
   void open(std::string_view magic, std::uint16_t version);
+  /// open() accepting any version in [oldest, newest]; returns the one found.
+  std::uint16_t open(std::string_view magic, std::uint16_t oldest, std::uint16_t newest);
   /// Throws unless every byte was read.
   void expect_end() const;
   [[noreturn]] void fail(const std::string& why) const;
@@ -71,7 +73,7 @@ class ByteReader {
 
  private:
   void require(std::size_t count, const char* field) const;
-  void expect_header(std::string_view magic, std::uint16_t version);
+  std::uint16_t expect_header(std::string_view magic, std::uint16_t oldest, std::uint16_t newest);
   void verify_checksum();
 
   std::string_view in_;

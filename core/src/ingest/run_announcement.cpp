@@ -12,7 +12,10 @@ namespace dynid::ingest {
 namespace {
 
 constexpr std::string_view kMagic = "DYNIDRUN";
+// Version 2 appends the declared channel noise; an announcement without any is written as
+// version 1, byte for byte as before (stored announcements and checkpoints keep matching).
 constexpr std::uint16_t kVersion = 1;
+constexpr std::uint16_t kVersionWithNoise = 2;
 
 [[noreturn]] void reject(const RunAnnouncement& a, const std::string& field,
                          const std::string& why) {
@@ -34,6 +37,13 @@ void validate_preprocessing(const RunAnnouncement& a) {
   if (!(p.filter_tolerance >= 1e-13 && p.filter_tolerance <= 1e-3))
     reject(a, "preprocessing.filter_tolerance",
            std::to_string(p.filter_tolerance) + " is outside [1e-13, 1e-3]");
+  for (const auto& [channel, sigma] : p.channel_noise) {
+    const std::string field = "preprocessing.channel_noise '" + input::printable(channel) + "'";
+    if (!(std::isfinite(sigma) && sigma > 0.0)) reject(a, field, std::to_string(sigma) + " is not a finite std > 0");
+    bool announced = false;
+    for (const ChannelSpec& c : a.channels) announced = announced || c.name == channel;
+    if (!announced) reject(a, field, "is not an announced channel");
+  }
 }
 
 void validate_models(const RunAnnouncement& a) {
@@ -81,7 +91,7 @@ std::size_t RunAnnouncement::column_of(const std::string& channel) const {
 std::string encode_announcement(const RunAnnouncement& a) {
   detail::ByteWriter w;
   w.bytes().append(kMagic);
-  w.put<std::uint16_t>(kVersion);
+  w.put<std::uint16_t>(a.preprocessing.channel_noise.empty() ? kVersion : kVersionWithNoise);
   w.put_string(a.vehicle);
   w.put_string(a.run);
   w.put<double>(a.sample_rate_hz);
@@ -108,13 +118,20 @@ std::string encode_announcement(const RunAnnouncement& a) {
   w.put<double>(p.filter_tolerance);
   w.put<std::uint32_t>(static_cast<std::uint32_t>(p.unfiltered.size()));
   for (const std::string& u : p.unfiltered) w.put_string(u);
+  if (!p.channel_noise.empty()) {
+    w.put<std::uint32_t>(static_cast<std::uint32_t>(p.channel_noise.size()));
+    for (const auto& [channel, sigma] : p.channel_noise) {
+      w.put_string(channel);
+      w.put<double>(sigma);
+    }
+  }
   w.seal();
   return w.take();
 }
 
 RunAnnouncement decode_announcement(std::string_view bytes) {
   detail::ByteReader r(bytes, "run announcement encoding");
-  r.open(kMagic, kVersion);
+  const std::uint16_t version = r.open(kMagic, kVersion, kVersionWithNoise);
   RunAnnouncement a;
   a.vehicle = r.get_string("vehicle");
   a.run = r.get_string("run");
@@ -148,6 +165,11 @@ RunAnnouncement decode_announcement(std::string_view bytes) {
   p.filter_tolerance = r.get<double>("filter tolerance");
   p.unfiltered.resize(count("unfiltered channel"));
   for (std::string& u : p.unfiltered) u = r.get_string("unfiltered channel");
+  if (version >= kVersionWithNoise)
+    for (auto n = count("channel noise"); n > 0; --n) {
+      std::string channel = r.get_string("noise channel");
+      p.channel_noise[channel] = r.get<double>("channel noise");
+    }
   r.expect_end();
   return a;
 }

@@ -78,6 +78,12 @@ const char* to_string(ParameterStatus status) {
       return "dependent";
     case ParameterStatus::kEliminated:
       return "eliminated";
+    case ParameterStatus::kPoorlyIdentified:
+      return "poorly identified";
+    case ParameterStatus::kNotExcited:
+      return "not excited";
+    case ParameterStatus::kImplausible:
+      return "implausible";
   }
   return "?";
 }

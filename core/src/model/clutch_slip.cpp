@@ -9,6 +9,7 @@
 
 namespace dynid::model {
 
+using detail::excited;
 using detail::parameter;
 using detail::positive;
 
@@ -52,9 +53,11 @@ std::function<double(double)> ClutchSlipModel::clamp_load() const {
 }
 
 std::vector<ParameterInfo> ClutchSlipModel::parameters() const {
-  return {positive(parameter("engine_inertia", "kg m^2", "engine and flywheel inertia J_e")),
-          detail::bounded(parameter("coulomb_friction", "-", "Coulomb friction coefficient mu_c"),
-                          0.0, 2.0)};
+  return {excited(positive(parameter("engine_inertia", "kg m^2", "engine and flywheel inertia J_e")),
+                  0.2, "d_engine_speed while the clutch slips (launches)"),
+          excited(detail::bounded(parameter("coulomb_friction", "-", "Coulomb friction coefficient mu_c"),
+                                  0.0, 2.0),
+                  0.3, "clutch_clamp_load while the clutch slips (launches)")};
 }
 
 std::vector<ChannelNeed> ClutchSlipModel::channels() const {

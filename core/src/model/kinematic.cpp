@@ -7,6 +7,7 @@
 
 namespace dynid::model {
 
+using detail::excited;
 using detail::parameter;
 using detail::positive;
 
@@ -29,8 +30,12 @@ std::vector<std::string> KinematicModel::measured_side() const {
 std::vector<ParameterInfo> KinematicModel::parameters() const {
   // The scale is a ratio of two gains near 1 (> 0: a negative one is a sensor mounted the
   // wrong way round or a sign error in the profile, not a car); the offset has either sign.
-  return {positive(parameter("sensor_scale", "-", "accelerometer gain over speed scale", 1.0)),
-          parameter("sensor_offset", "m/s^2", "accelerometer offset", 0.0)};
+  const std::string by = axis_ == Axis::kLongitudinal ? "d_vx (accelerate, brake)"
+                                                       : "d_vy + vx yaw_rate (corner)";
+  return {excited(positive(parameter("sensor_scale", "-", "accelerometer gain over speed scale", 1.0)),
+                  std::nullopt, by),
+          excited(parameter("sensor_offset", "m/s^2", "accelerometer offset", 0.0), std::nullopt,
+                  "time: any run")};
 }
 
 std::vector<ChannelNeed> KinematicModel::channels() const {

@@ -7,6 +7,7 @@
 
 namespace dynid::model {
 
+using detail::excited;
 using detail::parameter;
 using detail::positive;
 
@@ -29,6 +30,7 @@ ParameterInfo LateralBicycleModel::scaled(ParameterInfo p) const {
   // Dividing by an unknown M > 0 keeps a sign bound (0) and loses any other.
   if (p.lower && *p.lower != 0.0) p.lower.reset();
   if (p.upper && *p.upper != 0.0) p.upper.reset();
+  if (p.typical) *p.typical /= 1500.0;  // a typical passenger car's mass (kg)
   return p;
 }
 
@@ -36,9 +38,12 @@ std::vector<ParameterInfo> LateralBicycleModel::parameters() const {
   // C_f, C_r > 0 in this sign convention: the slip angles d_f = steer - atan(..) and d_r are
   // those that give a positive (leftward) force, F_y = C d.
   return {
-      scaled(positive(parameter("yaw_inertia", "kg m^2", "yaw inertia at the CG"))),
-      scaled(positive(parameter("front_cornering_stiffness", "N/rad", "front axle (both tyres)"))),
-      scaled(positive(parameter("rear_cornering_stiffness", "N/rad", "rear axle (both tyres)")))};
+      scaled(excited(positive(parameter("yaw_inertia", "kg m^2", "yaw inertia at the CG")), 2500.0,
+                     "d_yaw_rate (steer at several frequencies)")),
+      scaled(excited(positive(parameter("front_cornering_stiffness", "N/rad", "front axle (both tyres)")),
+                     1e5, "steer and ay (sine or step steer)")),
+      scaled(excited(positive(parameter("rear_cornering_stiffness", "N/rad", "rear axle (both tyres)")),
+                     1e5, "steer and ay (sine or step steer)"))};
 }
 
 std::vector<ChannelNeed> LateralBicycleModel::channels() const {

@@ -9,6 +9,7 @@
 namespace dynid::model {
 
 using detail::non_negative;
+using detail::excited;
 using detail::parameter;
 using detail::positive;
 
@@ -26,11 +27,16 @@ LockedDrivelineModel::LockedDrivelineModel(const Constants& constants) {
 std::vector<ParameterInfo> LockedDrivelineModel::parameters() const {
   // The road load only takes energy: p, q, r >= 0 (a negative p says that an ECU torque
   // offset, the same column, is in the data).
-  return {positive(parameter("equivalent_inertia", "kg m^2", "J_e + J_bv at the engine shaft")),
-          non_negative(
-              parameter("road_load_constant", "N m", "p: rolling resistance at the engine shaft")),
-          non_negative(parameter("road_load_linear", "N m s/rad", "q")),
-          non_negative(parameter("road_load_quadratic", "N m s^2/rad^2", "r: aerodynamic drag"))};
+  // No typical magnitude: at the engine shaft every one depends on the gear.
+  const std::string load = "engine_speed over a wide range in gear (coast down)";
+  return {excited(positive(parameter("equivalent_inertia", "kg m^2", "J_e + J_bv at the engine shaft")),
+                  std::nullopt, "d_engine_speed in gear (accelerate, brake)"),
+          excited(non_negative(
+                      parameter("road_load_constant", "N m", "p: rolling resistance at the engine shaft")),
+                  std::nullopt, load),
+          excited(non_negative(parameter("road_load_linear", "N m s/rad", "q")), std::nullopt, load),
+          excited(non_negative(parameter("road_load_quadratic", "N m s^2/rad^2", "r: aerodynamic drag")),
+                  std::nullopt, load)};
 }
 
 std::vector<ChannelNeed> LockedDrivelineModel::channels() const {

@@ -9,6 +9,7 @@
 namespace dynid::model {
 
 using detail::non_negative;
+using detail::excited;
 using detail::parameter;
 using detail::positive;
 
@@ -42,10 +43,15 @@ std::vector<std::string> LongitudinalModel::measured_side() const {
 std::vector<ParameterInfo> LongitudinalModel::parameters() const {
   // F_r >= 0: rolling resistance only takes energy (a negative one says that a torque offset,
   // the same column within a gear, is left in the data).
-  return {positive(parameter("mass", "kg", "vehicle mass (translating)")),
-          detail::drag_area("aerodynamic drag area S Cx"),
-          non_negative(
-              parameter("rolling_resistance", "N", "rolling resistance force F_r = C_rr M g"))};
+  // Typical magnitudes of a passenger car, for judging excitation only: at constant speed
+  // the drag and rolling-resistance columns are proportional (v^2 and 1).
+  return {excited(positive(parameter("mass", "kg", "vehicle mass (translating)")), 1500.0,
+                  "d_vx (accelerate, brake)"),
+          excited(detail::drag_area("aerodynamic drag area S Cx"), 0.7,
+                  "vx over a wide range (coast down from high speed)"),
+          excited(non_negative(parameter("rolling_resistance", "N",
+                                         "rolling resistance force F_r = C_rr M g")),
+                  200.0, "vx over a wide range (coast down from high speed)")};
 }
 
 std::vector<ChannelNeed> LongitudinalModel::channels() const {
@@ -91,8 +97,9 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
           {effect::kRoadGrade,
            "grade load M g sin(grade) from the road_grade channel",
            // A mass: > 0 with road_grade positive uphill (docs/CHANNELS.md).
-           {positive(parameter("grade_mass", "kg",
-                               "mass seen by the grade (= mass if grade explains it)"))},
+           {excited(positive(parameter("grade_mass", "kg",
+                                       "mass seen by the grade (= mass if grade explains it)")),
+                    1500.0, "road_grade (a hilly road)")},
            {"road_grade"}},
           [g](const ChannelSet& set) -> detail::ValueFn {
             const Eigen::VectorXd& grade = set["road_grade"];
@@ -101,7 +108,8 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
       detail::one_column(
           {effect::kRoadGradeAccelerometer,
            "grade load M (ax - d_vx): the accelerometer sees g sin(grade), the wheels do not",
-           {positive(parameter("grade_mass_accelerometer", "kg", "mass seen by the grade"))},
+           {excited(positive(parameter("grade_mass_accelerometer", "kg", "mass seen by the grade")),
+                    1500.0, "ax - d_vx (a hilly road)")},
            {"ax"}},
           [](const ChannelSet& set) -> detail::ValueFn {
             const Eigen::VectorXd& ax = set["ax"];

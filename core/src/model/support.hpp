@@ -52,6 +52,14 @@ inline ParameterInfo non_negative(ParameterInfo p) {
   return p;
 }
 
+/// Excitation facts (ParameterInfo::typical, excited_by; model/parameter_status.hpp):
+/// excited(positive(parameter("mass", ...)), 1500.0, "d_vx (accelerate, brake)").
+inline ParameterInfo excited(ParameterInfo p, std::optional<double> typical, std::string by) {
+  p.typical = typical;
+  p.excited_by = std::move(by);
+  return p;
+}
+
 /// <= 0: a term that can only take away (a tyre's saturation).
 inline ParameterInfo non_positive(ParameterInfo p) {
   p.upper = 0.0;

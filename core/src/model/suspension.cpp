@@ -8,6 +8,7 @@
 namespace dynid::model {
 
 using detail::non_negative;
+using detail::excited;
 using detail::parameter;
 using detail::positive;
 
@@ -19,10 +20,15 @@ SuspensionModel::SuspensionModel(const Constants& constants, const std::string& 
 std::vector<ParameterInfo> SuspensionModel::parameters() const {
   // Travel and force both positive in compression: k > 0, h >= 0 and f_s >= 0 (a damper and
   // a friction only dissipate); the offset -k z0 has either sign.
-  return {positive(parameter("stiffness", "N/m", "spring stiffness k")),
-          non_negative(parameter("damping", "N s/m", "damper coefficient h")),
-          non_negative(parameter("dry_friction", "N", "Coulomb friction f_s")),
-          parameter("force_offset", "N", "-k z0 (preload, travel sensor offset)")};
+  const std::string travel = "susp_travel_" + corner_;
+  return {excited(positive(parameter("stiffness", "N/m", "spring stiffness k")), 3e4,
+                  travel + " (roll, pitch, heave)"),
+          excited(non_negative(parameter("damping", "N s/m", "damper coefficient h")), 2000.0,
+                  "d_" + travel + " (body motion)"),
+          excited(non_negative(parameter("dry_friction", "N", "Coulomb friction f_s")), 100.0,
+                  "d_" + travel + " changing sign (body motion)"),
+          excited(parameter("force_offset", "N", "-k z0 (preload, travel sensor offset)"), std::nullopt,
+                  "time: any run")};
 }
 
 std::vector<ChannelNeed> SuspensionModel::channels() const {

@@ -6,6 +6,7 @@
 namespace dynid::model {
 
 using detail::non_negative;
+using detail::excited;
 using detail::parameter;
 using detail::positive;
 
@@ -15,8 +16,10 @@ TyreVerticalModel::TyreVerticalModel(const Constants&, const std::string& corner
 }
 
 std::vector<ParameterInfo> TyreVerticalModel::parameters() const {
-  return {positive(parameter("vertical_stiffness", "N/m", "tyre vertical stiffness k_p")),
-          parameter("force_offset", "N", "load at zero measured deflection (sensor offsets)")};
+  return {excited(positive(parameter("vertical_stiffness", "N/m", "tyre vertical stiffness k_p")), 2.5e5,
+                  "tyre_deflection_" + corner_ + " (load transfer: steer, brake, bumps)"),
+          excited(parameter("force_offset", "N", "load at zero measured deflection (sensor offsets)"),
+                  std::nullopt, "time: any run")};
 }
 
 std::vector<ChannelNeed> TyreVerticalModel::channels() const {

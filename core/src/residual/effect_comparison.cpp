@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "dynid/model/parameter_status.hpp"
+
 namespace dynid::residual {
 namespace {
 
@@ -43,13 +45,17 @@ EffectComparison compare_effect(const model::Model& model, const std::vector<std
   c.after = fit_model(model, with, run, sample_rate_hz, odmf, same_scale);
   const ls::Estimate& b = c.before.estimate;
   const ls::Estimate& a = c.after.estimate;
+  const auto status_b = model::classify_parameters(c.before.parameters, b, c.before.column_norms);
+  const auto status_a = model::classify_parameters(c.after.parameters, a, c.after.column_norms);
   for (std::size_t i = 0; i < c.after.parameters.size(); ++i) {
     const model::ParameterInfo& p = c.after.parameters[i];
     ParameterChange change{p.name, p.unit, kNaN, kNaN, a.value(static_cast<Eigen::Index>(i)),
                            a.standard_deviation(static_cast<Eigen::Index>(i)), std::nullopt};
+    change.status_after = status_a.parameters[i].status;
     if (i < c.before.parameters.size()) {
       change.before = b.value(static_cast<Eigen::Index>(i));
       change.std_before = b.standard_deviation(static_cast<Eigen::Index>(i));
+      change.status_before = status_b.parameters[i].status;
     }
     if (const auto t = truth.find(p.name); t != truth.end()) change.truth = t->second;
     c.parameters.push_back(change);

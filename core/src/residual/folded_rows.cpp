@@ -8,6 +8,7 @@
 #include <Eigen/QR>
 
 #include "dynid/error.hpp"
+#include "dynid/model/parameter_status.hpp"
 #include "dynid/residual/road_profile.hpp"
 #include "dynid/residual/signal_delay.hpp"
 #include "dynid/residual/varying_parameter.hpp"
@@ -363,6 +364,7 @@ Evaluation evaluate(const FoldedRows& rows, const std::vector<Eigen::Index>& col
   Evaluation e;
   const ls::EquationGroups all = merged(folds, -1, names);
   ls::WeightedEstimate fit = all.estimate();
+  e.column_norms = model::column_norms(fit.weighted);
   e.all = std::move(fit.estimate);
   e.group_statistics = std::move(fit.groups);
   e.x = base_solution(e.all);

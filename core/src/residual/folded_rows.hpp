@@ -59,6 +59,7 @@ RowSelection kept_rows(const model::Model& model, const std::vector<std::string>
 
 struct Evaluation {
   ls::Estimate all;
+  Eigen::VectorXd column_norms;        // of the weighted system of `all` (parameter status)
   std::vector<ls::GroupStatistics> group_statistics;
   Eigen::VectorXd x;                   // the in-sample solution, 0 where not identifiable
   std::vector<double> weights;         // per group (fixed or the fit's own 1/sigma_j)

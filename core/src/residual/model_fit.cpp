@@ -64,6 +64,7 @@ ModelFit fit_model(const model::Model& model, const std::vector<std::string>& ef
   fit.effects = effects;
   fit.parameters = rows.parameters;
   fit.estimate = e.all;
+  fit.column_norms = e.column_norms;
   fit.group_statistics = e.group_statistics;
   fit.profile_knots_m = rows.profile_knots_m;
   for (std::size_t g = 0; g < rows.groups.size(); ++g) {

@@ -1,6 +1,7 @@
 // Conversions of the ingest topics: RunAnnouncement and Chunk.
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <string>
 
 #include <dynid/input/ids.hpp>
@@ -19,15 +20,32 @@ namespace {
 
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
+// A name -> value map as a bounded sequence of NamedValue (`what`: "constant", "channel noise").
+template <typename Sequence>
+void put_named(Sequence& out, const std::map<std::string, double>& values, std::size_t bound,
+               const std::string& where, const std::string& what) {
+  auto* entries = allocate(out, values.size(), bound, where + " " + what);
+  std::size_t k = 0;
+  for (const auto& [name, value] : values) {
+    put_id(entries[k].name, name, where + " " + what + " name");
+    entries[k++].value = value;
+  }
+}
+
+template <typename Sequence>
+std::map<std::string, double> get_named(const Sequence& in, std::size_t bound, const std::string& where,
+                                        const std::string& what) {
+  std::map<std::string, double> out;
+  for (const auto& entry : elements(in, bound, where + " " + what)) {
+    const std::string name = get(entry.name, where + " " + what + " name");
+    if (!out.emplace(name, entry.value).second) throw InputError(where + ": duplicate " + what + " '" + name + "'");
+  }
+  return out;
+}
+
 void put_model(dynid_wire_ModelSpec& out, const ingest::ModelSpec& model, const std::string& where) {
   put_id(out.model, model.model, where + " model");
-  auto* constants = allocate(out.constants, model.constants.size(), dynid_wire_kMaxConstants,
-                             where + " constants");
-  std::size_t k = 0;
-  for (const auto& [name, value] : model.constants) {
-    put_id(constants[k].name, name, where + " constant name");
-    constants[k++].value = value;
-  }
+  put_named(out.constants, model.constants, dynid_wire_kMaxConstants, where, "constant");
   auto* effects =
       allocate(out.effects, model.effects.size(), dynid_wire_kMaxEffects, where + " effects");
   for (std::size_t e = 0; e < model.effects.size(); ++e)
@@ -38,11 +56,7 @@ ingest::ModelSpec get_model(const dynid_wire_ModelSpec& in, const std::string& w
   ingest::ModelSpec model;
   model.model = get(in.model, where + " model");
   const std::string at = where + " '" + model.model + "'";
-  for (const auto& constant : elements(in.constants, dynid_wire_kMaxConstants, at + " constants")) {
-    const std::string name = get(constant.name, at + " constant name");
-    if (!model.constants.emplace(name, constant.value).second)
-      throw InputError(at + ": duplicate constant '" + name + "'");
-  }
+  model.constants = get_named(in.constants, dynid_wire_kMaxConstants, at, "constant");
   for (const auto& effect : elements(in.effects, dynid_wire_kMaxEffects, at + " effects"))
     model.effects.push_back(get(effect, at + " effect"));
   return model;
@@ -76,6 +90,13 @@ Sample<dynid_wire_RunAnnouncement> to_wire(const ingest::RunAnnouncement& announ
       allocate(out.models, announcement.models.size(), dynid_wire_kMaxModels, where + " models");
   for (std::size_t m = 0; m < announcement.models.size(); ++m)
     put_model(models[m], announcement.models[m], where);
+  // Preprocessing: what the wire carries of it (the filter tolerance and the unfiltered
+  // channels stay the server's defaults).
+  const ingest::Preprocessing& p = announcement.preprocessing;
+  out.butterworth_order = p.butterworth_order;
+  out.cutoff_hz = p.cutoff_hz;
+  out.odmf = p.odmf;
+  put_named(out.channel_noise, p.channel_noise, dynid_wire_kMaxChannels, where, "channel noise");
   return sample;
 }
 
@@ -90,6 +111,13 @@ ingest::RunAnnouncement from_wire(const dynid_wire_RunAnnouncement& sample) {
         {get(channel.name, where + " channel name"), get(channel.unit, where + " channel unit")});
   for (const auto& model : elements(sample.models, dynid_wire_kMaxModels, where + " models"))
     announcement.models.push_back(get_model(model, where));
+  // Zeros: the defaults (an older car sends no preprocessing). validate() judges the rest.
+  ingest::Preprocessing& p = announcement.preprocessing;
+  const auto& in = sample;
+  if (in.butterworth_order != 0) p.butterworth_order = in.butterworth_order;
+  p.cutoff_hz = in.cutoff_hz;
+  if (in.odmf != 0) p.odmf = in.odmf;
+  p.channel_noise = get_named(in.channel_noise, dynid_wire_kMaxChannels, where, "channel noise");
   return announcement;
 }
 

@@ -3,7 +3,9 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <tuple>
 #include <type_traits>
+#include <utility>
 
 #include "dynid/dds/conversions.hpp"
 #include "wire_fields.hpp"
@@ -18,12 +20,17 @@ using wire_fields::put_text;
 
 namespace {
 
-dynid_wire_ParameterStatus to_wire_status(ls::ParameterStatus status) {
+// The wire's (status, verdict) pair: the refined statuses travel as IDENTIFIED plus a verdict,
+// so that a reader of the first release's types still reads them (as identified).
+std::pair<dynid_wire_ParameterStatus, dynid_wire_ParameterVerdict> to_wire_status(ls::ParameterStatus status) {
   switch (status) {
-    case ls::ParameterStatus::kIdentified: return dynid_wire_IDENTIFIED;
-    case ls::ParameterStatus::kRegrouped: return dynid_wire_REGROUPED;
-    case ls::ParameterStatus::kDependent: return dynid_wire_DEPENDENT;
-    case ls::ParameterStatus::kEliminated: return dynid_wire_ELIMINATED;
+    case ls::ParameterStatus::kIdentified: return {dynid_wire_IDENTIFIED, dynid_wire_NO_VERDICT};
+    case ls::ParameterStatus::kRegrouped: return {dynid_wire_REGROUPED, dynid_wire_NO_VERDICT};
+    case ls::ParameterStatus::kDependent: return {dynid_wire_DEPENDENT, dynid_wire_NO_VERDICT};
+    case ls::ParameterStatus::kEliminated: return {dynid_wire_ELIMINATED, dynid_wire_NO_VERDICT};
+    case ls::ParameterStatus::kPoorlyIdentified: return {dynid_wire_IDENTIFIED, dynid_wire_POORLY_IDENTIFIED};
+    case ls::ParameterStatus::kNotExcited: return {dynid_wire_IDENTIFIED, dynid_wire_NOT_EXCITED};
+    case ls::ParameterStatus::kImplausible: return {dynid_wire_IDENTIFIED, dynid_wire_IMPLAUSIBLE};
   }
   throw InputError("Estimate: unknown parameter status");
 }
@@ -44,6 +51,17 @@ ls::ParameterStatus parameter_status_from_wire(long long raw, const std::string&
   if (raw == dynid_wire_DEPENDENT) return ls::ParameterStatus::kDependent;
   if (raw == dynid_wire_ELIMINATED) return ls::ParameterStatus::kEliminated;
   throw InputError(where + ": unknown status " + std::to_string(raw));
+}
+
+// A verdict refines IDENTIFIED only (NO_VERDICT leaves the status as it is).
+ls::ParameterStatus refined_from_wire(ls::ParameterStatus status, long long verdict, const std::string& where) {
+  if (verdict == dynid_wire_NO_VERDICT) return status;
+  if (status != ls::ParameterStatus::kIdentified)
+    throw InputError(where + ": verdict " + std::to_string(verdict) + " on a parameter that is not identified");
+  if (verdict == dynid_wire_POORLY_IDENTIFIED) return ls::ParameterStatus::kPoorlyIdentified;
+  if (verdict == dynid_wire_NOT_EXCITED) return ls::ParameterStatus::kNotExcited;
+  if (verdict == dynid_wire_IMPLAUSIBLE) return ls::ParameterStatus::kImplausible;
+  throw InputError(where + ": unknown verdict " + std::to_string(verdict));
 }
 
 dynid_wire_ReplyStatus to_wire_status(ReplyStatus status) {
@@ -77,8 +95,9 @@ void put_parameter(dynid_wire_ParameterRow& out, const ParameterEntry& entry,
   out.value = entry.value;
   out.standard_deviation = entry.standard_deviation;
   out.relative_std_percent = entry.relative_std_percent;
-  out.status = to_wire_status(entry.status);
+  std::tie(out.status, out.verdict) = to_wire_status(entry.status);
   put_text(out.relation, entry.relation);
+  put_text(out.reason, entry.reason);
 }
 
 ParameterEntry get_parameter(const dynid_wire_ParameterRow& in, const std::string& where) {
@@ -89,8 +108,10 @@ ParameterEntry get_parameter(const dynid_wire_ParameterRow& in, const std::strin
   entry.value = in.value;
   entry.standard_deviation = in.standard_deviation;
   entry.relative_std_percent = in.relative_std_percent;
-  entry.status = parameter_status_from_wire(wire_enum_value(in.status), at);
+  entry.status = refined_from_wire(parameter_status_from_wire(wire_enum_value(in.status), at),
+                                   wire_enum_value(in.verdict), at);
   entry.relation = get(in.relation, at + " relation");
+  entry.reason = get(in.reason, at + " reason");
   return entry;
 }
 
@@ -153,6 +174,7 @@ Sample<dynid_wire_Estimate> to_wire(const EstimateTable& table) {
     groups[k].rows = table.groups[k].rows;
     groups[k].residual_rms = table.groups[k].residual_rms;
   }
+  put_text(out.not_excited, table.not_excited);
   return sample;
 }
 
@@ -173,6 +195,7 @@ EstimateTable from_wire(const dynid_wire_Estimate& sample) {
   table.relative_residual_norm = sample.relative_residual_norm;
   for (const auto& group : elements(sample.groups, dynid_wire_kMaxGroups, where + " groups"))
     table.groups.push_back({get(group.group, where + " group name"), group.rows, group.residual_rms});
+  table.not_excited = get(sample.not_excited, where + " not_excited");
   return table;
 }
 

@@ -51,4 +51,16 @@ EstimateTable make_estimate_table(const std::string& vehicle, const std::string&
   return table;
 }
 
+void apply_verdict(EstimateTable& table, const model::ModelVerdict& verdict) {
+  if (verdict.parameters.size() != table.parameters.size())
+    throw InputError("apply_verdict " + table.vehicle + "/" + table.model + ": " +
+                     std::to_string(verdict.parameters.size()) + " verdicts for " +
+                     std::to_string(table.parameters.size()) + " parameters");
+  for (std::size_t j = 0; j < verdict.parameters.size(); ++j) {
+    table.parameters[j].status = verdict.parameters[j].status;
+    table.parameters[j].reason = verdict.parameters[j].reason;
+  }
+  table.not_excited = verdict.not_excited;
+}
+
 }  // namespace dynid::dds

@@ -17,20 +17,22 @@ std::string cell(double value) {
 }
 
 std::string parameter_line(const dds::ParameterEntry& p) {
-  std::string line = fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {:<10}", p.name, p.unit,
+  std::string line = fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {:<17}", p.name, p.unit,
                                  cell(p.value), cell(p.standard_deviation),
                                  cell(p.relative_std_percent), status_name(p.status));
   if (!p.relation.empty()) line += "  = " + p.relation;
+  if (!p.reason.empty()) line += "  " + p.reason;
+  while (!line.empty() && line.back() == ' ') line.pop_back();
   return line + "\n";
 }
 
 std::string parameter_json(const dds::ParameterEntry& p) {
   return fmt::format(
       "{{\"name\":{},\"unit\":{},\"value\":{},\"std\":{},\"relative_std_percent\":{},"
-      "\"status\":{},\"relation\":{}}}",
+      "\"status\":{},\"relation\":{},\"reason\":{}}}",
       json_string(p.name), json_string(p.unit), json_number(p.value),
       json_number(p.standard_deviation), json_number(p.relative_std_percent),
-      json_string(status_name(p.status)), json_string(p.relation));
+      json_string(status_name(p.status)), json_string(p.relation), json_string(p.reason));
 }
 
 }  // namespace
@@ -41,6 +43,9 @@ const char* status_name(ls::ParameterStatus status) {
     case ls::ParameterStatus::kRegrouped: return "regrouped";
     case ls::ParameterStatus::kDependent: return "dependent";
     case ls::ParameterStatus::kEliminated: return "eliminated";
+    case ls::ParameterStatus::kPoorlyIdentified: return "poorly identified";
+    case ls::ParameterStatus::kNotExcited: return "not excited";
+    case ls::ParameterStatus::kImplausible: return "implausible";
   }
   return "unknown";
 }
@@ -48,7 +53,11 @@ const char* status_name(ls::ParameterStatus status) {
 std::string format_estimate_text(const dds::EstimateTable& t) {
   std::string out = fmt::format("{} / {}  (source {}, revision {})\n", t.vehicle, t.model,
                                 t.source, t.revision);
-  out += fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {:<10}\n", "parameter", "unit", "value",
+  // A model the run does not excite: one line, no numbers that would read as estimates.
+  if (!t.not_excited.empty())
+    return out + fmt::format("  not excited by this run: {} ({} rows; --json has the numbers)\n",
+                             t.not_excited, t.rows);
+  out += fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {}\n", "parameter", "unit", "value",
                      "std", "rel.std%", "status");
   for (const auto& p : t.parameters) out += parameter_line(p);
   out += fmt::format("  rows {}  sigma {}  cond {}  residual RMS {}  relative residual {}\n",
@@ -71,11 +80,11 @@ std::string estimate_json(const dds::EstimateTable& t) {
   return fmt::format(
       "{{\"vehicle\":{},\"model\":{},\"source\":{},\"revision\":{},\"parameters\":[{}],"
       "\"rows\":{},\"effective_rows\":{},\"sigma\":{},\"condition_number\":{},"
-      "\"residual_rms\":{},\"relative_residual_norm\":{},\"groups\":[{}]}}",
+      "\"residual_rms\":{},\"relative_residual_norm\":{},\"groups\":[{}],\"not_excited\":{}}}",
       json_string(t.vehicle), json_string(t.model), json_string(t.source), t.revision, parameters,
       t.rows, json_number(t.effective_rows), json_number(t.sigma),
       json_number(t.condition_number), json_number(t.residual_rms),
-      json_number(t.relative_residual_norm), groups);
+      json_number(t.relative_residual_norm), groups, json_string(t.not_excited));
 }
 
 std::string estimates_json(const std::vector<dds::EstimateTable>& tables) {

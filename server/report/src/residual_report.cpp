@@ -20,6 +20,14 @@ bool is_profile_knot(const residual::ParameterChange& p) {
   return residual::is_road_profile_effect(p.name.substr(0, p.name.find('@')));
 }
 
+// "not excited -> identified", or one status when the effect did not change it.
+std::string status_change(const residual::ParameterChange& p) {
+  const std::string after = ls::to_string(p.status_after);
+  if (!p.status_before) return "-> " + after;
+  const std::string before = ls::to_string(*p.status_before);
+  return before == after ? after : before + " -> " + after;
+}
+
 }  // namespace
 
 std::string format_screen_text(const residual::ScreenResult& screen, std::size_t top) {
@@ -57,17 +65,17 @@ std::string format_screen_text(const residual::ScreenResult& screen, std::size_t
 
 std::string format_comparison_text(const residual::EffectComparison& c) {
   std::string out = fmt::format("add {} to {}\n", c.effect, c.before.model);
-  out += fmt::format("{:<30} {:>14} {:>12} {:>9} | {:>14} {:>12} {:>9}\n", "parameter", "before", "std", "err %",
-                     "after", "std", "err %");
+  out += fmt::format("{:<30} {:>14} {:>12} {:>9} | {:>14} {:>12} {:>9}  {}\n", "parameter", "before", "std", "err %",
+                     "after", "std", "err %", "status");
   std::size_t knots = 0;
   for (const residual::ParameterChange& p : c.parameters) {
     if (is_profile_knot(p) && !p.truth) {
       ++knots;
       continue;
     }
-    out += fmt::format("{:<30} {:>14} {:>12} {:>9} | {:>14} {:>12} {:>9}\n", p.name, number(p.before),
+    out += fmt::format("{:<30} {:>14} {:>12} {:>9} | {:>14} {:>12} {:>9}  {}\n", p.name, number(p.before),
                        number(p.std_before), percent(p.error_before_percent()), number(p.after),
-                       number(p.std_after), percent(p.error_after_percent()));
+                       number(p.std_after), percent(p.error_after_percent()), status_change(p));
   }
   if (knots > 0)
     out += fmt::format("({} road-profile knot parameters, every {:.0f} m, not listed)\n", knots,
@@ -260,7 +268,9 @@ json comparison_object(const residual::EffectComparison& c) {
                           {"std_after", finite(p.std_after)},
                           {"reference", p.truth ? finite(*p.truth) : json(nullptr)},
                           {"error_before_percent", finite(p.error_before_percent())},
-                          {"error_after_percent", finite(p.error_after_percent())}});
+                          {"error_after_percent", finite(p.error_after_percent())},
+                          {"status_before", p.status_before ? json(ls::to_string(*p.status_before)) : json(nullptr)},
+                          {"status_after", ls::to_string(p.status_after)}});
   return {{"effect", c.effect},
           {"parameters", parameters},
           {"groups_before", fit_groups(c.before)},

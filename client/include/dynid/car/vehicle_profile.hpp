@@ -26,6 +26,13 @@
 //   name = "longitudinal_engine"       # model registry name
 //   effects = ["road_grade"]           # optional
 //   constants = { driveline_efficiency = 0.9 }   # optional, added to / override [constants]
+//   [preprocessing]                    # optional; every key defaults to the server's (DYCARO's)
+//   butterworth_order = 5              # zero-phase low-pass order, 1..8
+//   cut_off_hz = 5.0                   # -3 dB, below rate_hz / 2; absent: 0.8 rate_hz / (2 odmf)
+//   odmf = 8                           # rows on every odmf-th grid sample (decimation), 1..1000
+//   noise = { ax = 0.05 }              # declared sensor noise std per channel (its SI unit),
+//                                      # used by the residual loop's noise floor instead of
+//                                      # measuring it above the cut-off
 //   [[channels]]
 //   name = "vx"                        # catalogue channel; its SI unit comes from the catalogue
 //   message = "WHEEL_SPEEDS"           # DBC message name
@@ -178,6 +185,8 @@ struct VehicleProfile {
   std::vector<ingest::ModelSpec> models;
   std::filesystem::path spool_directory;
   std::uint64_t spool_max_bytes = 0;
+  /// [preprocessing]: carried in every run's announcement to the server (defaults: DYCARO's).
+  ingest::Preprocessing preprocessing;
 
   bool accepts_interface(std::string_view name) const;
   /// The announcement of a run of this vehicle (channels with units, rate, models).

@@ -57,6 +57,10 @@ struct Preprocessing {
   /// Channels passed through as they are (delayed to stay aligned): discrete ones, which a
   /// low-pass would smear across a gear change. Names not announced are ignored.
   std::vector<std::string> unfiltered = {"gear", "gear_ratio"};
+  /// Declared sensor noise: channel -> white-noise std at the grid rate, in the channel's unit
+  /// (finite, > 0; an announced channel). The residual loop's noise floor uses it instead of
+  /// measuring the channel above the cut-off (residual/noise_floor.hpp). Empty: all measured.
+  std::map<std::string, double> channel_noise;
 
   /// The cut-off actually used, Hz.
   double cutoff(double sample_rate_hz) const;

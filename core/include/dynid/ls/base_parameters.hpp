@@ -26,6 +26,12 @@ enum class ParameterStatus {
   kRegrouped,   ///< independent column whose value absorbs dependent ones (see relation)
   kDependent,   ///< linear combination of earlier columns: regrouped into them, no own value
   kEliminated,  ///< negligible column (not excited): no value
+  // What the data say about an identified column's value (never set by
+  // analyse_base_parameters; model::classify_parameters refines kIdentified into these,
+  // dynid/model/parameter_status.hpp, where the rules are stated):
+  kPoorlyIdentified,  ///< relative std above DYCARO's limits
+  kNotExcited,        ///< the run carries (almost) no information about it
+  kImplausible,       ///< outside the model's physical bounds by more than 2 std
 };
 
 const char* to_string(ParameterStatus status);

@@ -42,6 +42,14 @@ struct ParameterInfo {
   std::optional<double> upper = std::nullopt;  ///< physical upper bound, if any
   bool lower_inclusive = false;  ///< value == lower allowed (">= 0"); default strict ("> 0")
   bool upper_inclusive = true;   ///< value == upper allowed ("<= 2"); default inclusive
+  /// Excitation (dynid/model/parameter_status.hpp): the order of magnitude the quantity has on
+  /// a passenger car (1500 kg, 0.2 kg m^2), only to judge whether a run carries information
+  /// about it; never a prior, never in the fit. Absent where no magnitude is typical.
+  std::optional<double> typical = std::nullopt;
+  /// The signal that must move for the column to carry information, named by its channel and
+  /// the manoeuvre that moves it: "d_vx (accelerate, brake)". Printed for a parameter the run
+  /// does not excite.
+  std::string excited_by = {};
 
   /// True when `value` is within the bounds, and for NaN: a parameter that is not identifiable
   /// (NaN estimate) is not out of bounds. +-Inf is out of any bound on its side.

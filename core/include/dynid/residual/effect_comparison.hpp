@@ -22,6 +22,9 @@ struct ParameterChange {
   double after = 0.0;
   double std_after = 0.0;
   std::optional<double> truth;
+  /// Statuses (model/parameter_status.hpp) in each fit; before: nullopt for the effect's own.
+  std::optional<ls::ParameterStatus> status_before = std::nullopt;
+  ls::ParameterStatus status_after = ls::ParameterStatus::kIdentified;
   double error_before_percent() const;  ///< NaN without truth
   double error_after_percent() const;
 };

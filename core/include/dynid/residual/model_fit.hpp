@@ -53,6 +53,7 @@ struct ModelFit {
   std::vector<std::string> effects;  ///< as enabled, the added one last
   std::vector<model::ParameterInfo> parameters;
   ls::Estimate estimate;  ///< DYCARO's weighted estimate (values, std in the parameters' units)
+  Eigen::VectorXd column_norms;  ///< of its weighted system, for model::classify_parameters
   std::vector<ls::GroupStatistics> group_statistics;  ///< sigma_j and weights
   std::vector<GroupFit> groups;
   std::vector<ResidualSeries> series;

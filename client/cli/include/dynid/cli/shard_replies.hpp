@@ -57,6 +57,10 @@ std::vector<std::string> merged_vehicles(const ShardReplies& replies);
 /// The vehicle list as `dynid vehicles` prints it: one per line, or a JSON array.
 std::string render_vehicles(const std::vector<std::string>& vehicles, bool json);
 std::string merged_status(const ShardReplies& replies);
+/// `dynid status` for people: per shard (a heading when there are several) one line per
+/// counter, with what it counts ("chunks stored durably ... 40"), and a line per shard that did
+/// not answer. Counters this client does not know are printed by their JSON name.
+std::string status_text(const ShardReplies& replies);
 /// E.g. "shard 1/2 did not answer within 10000 ms: its vehicles are not included" (`what`:
 /// "vehicles"). Empty when nothing is missing.
 std::string missing_note(const ShardReplies& replies, std::int64_t timeout_ms, const std::string& what);

@@ -6,12 +6,15 @@
 // make_estimate_table() builds it from an ls::Estimate; `names` and `units` are the model's
 // parameter names and units, in its column order (InputError if their sizes differ from the
 // estimate's). Relations are filled for regrouped parameters (BaseParameterAnalysis::relation).
+// Statuses are the base-parameter analysis' until the caller refines them
+// (apply_verdict(), with model::classify_parameters: poorly identified, not excited, implausible).
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "dynid/ls/base_parameters.hpp"
 #include "dynid/ls/estimate.hpp"
+#include "dynid/model/parameter_status.hpp"
 
 namespace dynid::dds {
 
@@ -23,6 +26,7 @@ struct ParameterEntry {
   double relative_std_percent = 0.0;  ///< 100 sigma / |value|
   ls::ParameterStatus status = ls::ParameterStatus::kIdentified;
   std::string relation;  ///< for kRegrouped: the base-parameter combination
+  std::string reason = {};  ///< why the status (model/parameter_status.hpp); "" when identified
 };
 
 struct GroupResidual {
@@ -44,6 +48,8 @@ struct EstimateTable {
   double residual_rms = 0.0;
   double relative_residual_norm = 0.0;
   std::vector<GroupResidual> groups;
+  /// "" unless the source excites none of the parameters; then what would ("needs d_vx (...)").
+  std::string not_excited = {};
 };
 
 EstimateTable make_estimate_table(const std::string& vehicle, const std::string& model,
@@ -51,5 +57,9 @@ EstimateTable make_estimate_table(const std::string& vehicle, const std::string&
                                   const std::vector<std::string>& names,
                                   const std::vector<std::string>& units,
                                   const ls::Estimate& estimate);
+
+/// Puts the statuses, reasons and model-level note of a classification on the table (sizes must
+/// match: InputError).
+void apply_verdict(EstimateTable& table, const model::ModelVerdict& verdict);
 
 }  // namespace dynid::dds

@@ -1,0 +1,127 @@
+// What the dynid CLI prints for people and tools, without DDS (issue 16, items 1 and 6): the compact
+// view of `dynid watch --model` (how a value moved, the in-place redraw, JSON lines) and
+// `dynid status` as text, and the estimate table of a model the run does not excite.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "dynid/cli/shard_replies.hpp"
+#include "dynid/cli/watch_view.hpp"
+#include "dynid/report/estimate_report.hpp"
+
+namespace dynid::test {
+namespace {
+
+dds::EstimateTable table(std::uint64_t revision, double mass, double mass_std) {
+  dds::EstimateTable t;
+  t.vehicle = "car";
+  t.model = "longitudinal_wheel";
+  t.source = "run-1";
+  t.revision = revision;
+  t.rows = 100 * revision;
+  t.parameters.push_back({"mass", "kg", mass, mass_std, 100.0 * mass_std / mass,
+                          ls::ParameterStatus::kIdentified, "", ""});
+  t.parameters.push_back({"SCx", "m^2", -6.7, 0.96, 14.3, ls::ParameterStatus::kNotExcited, "",
+                          "not excited: std 0.96 m^2 >= 0.7 m^2"});
+  return t;
+}
+
+TEST(WatchView, OneLinePerParameterWithHowItMoved) {
+  cli::WatchView view;
+  const std::string first = view.text(table(1, 1500.0, 10.0));
+  EXPECT_NE(first.find("car / longitudinal_wheel  source run-1, revision 1, rows 100"), std::string::npos) << first;
+  EXPECT_NE(first.find("moved since last"), std::string::npos) << first;
+  EXPECT_NE(first.find("identified"), std::string::npos) << first;
+  EXPECT_NE(first.find("not excited"), std::string::npos) << first;
+  EXPECT_NE(first.find("new"), std::string::npos) << first;
+  EXPECT_EQ(cli::line_count(first), 4u) << first;  // heading, column names, two parameters
+  const std::string second = view.text(table(2, 1480.0, 5.0));
+  EXPECT_NE(second.find("-20 (-4 std)"), std::string::npos) << second;  // moved 20 kg = 4 new std
+  EXPECT_NE(second.find("  0\n"), std::string::npos) << second;         // SCx did not move
+}
+
+TEST(WatchView, AModelTheRunDoesNotExciteIsOneLine) {
+  cli::WatchView view;
+  auto t = table(1, 160.0, 24.0);
+  t.not_excited = "needs d_vx (accelerate, brake)";
+  const std::string text = view.text(t);
+  EXPECT_EQ(cli::line_count(text), 2u) << text;
+  EXPECT_NE(text.find("  not excited by this run: needs d_vx (accelerate, brake)\n"), std::string::npos) << text;
+  EXPECT_EQ(text.find("160"), std::string::npos) << text;  // no number that reads as an estimate
+}
+
+TEST(WatchView, RedrawMovesTheCursorOverThePreviousBlock) {
+  cli::WatchView view;
+  const std::string first = view.redraw(table(1, 1500.0, 10.0));
+  EXPECT_EQ(first.find('\x1b'), std::string::npos) << first;
+  const std::string second = view.redraw(table(2, 1490.0, 10.0));
+  EXPECT_EQ(second.rfind("\x1b[4A\x1b[J", 0), 0u) << second;
+  EXPECT_EQ(cli::line_count(second), 4u);
+}
+
+TEST(WatchView, JsonLinesCarryTheStatusAndTheMove) {
+  cli::WatchView view;
+  const std::string first = view.json_line(table(1, 1500.0, 10.0));
+  const std::string second = view.json_line(table(2, 1480.0, 5.0));
+  ASSERT_EQ(cli::line_count(first), 1u);
+  ASSERT_EQ(first.back(), '\n');
+  const auto a = nlohmann::json::parse(first);
+  const auto b = nlohmann::json::parse(second);
+  EXPECT_EQ(a["model"], "longitudinal_wheel");
+  EXPECT_EQ(a["revision"], 1);
+  EXPECT_TRUE(a["parameters"][0]["change"].is_null());
+  EXPECT_EQ(a["parameters"][1]["status"], "not excited");
+  EXPECT_EQ(a["parameters"][1]["reason"], "not excited: std 0.96 m^2 >= 0.7 m^2");
+  EXPECT_DOUBLE_EQ(b["parameters"][0]["change"].get<double>(), -20.0);
+  EXPECT_DOUBLE_EQ(b["parameters"][0]["change_in_std"].get<double>(), -4.0);
+  EXPECT_EQ(b["not_excited"], "");
+}
+
+// `dynid estimates` (and every table of the server's replies) prints the same one line.
+TEST(EstimateText, AModelTheRunDoesNotExciteIsOneLineAndItsJsonKeepsTheNumbers) {
+  auto t = table(3, 160.0, 24.0);
+  t.not_excited = "needs d_vx (accelerate, brake)";
+  const std::string text = report::format_estimate_text(t);
+  EXPECT_EQ(cli::line_count(text), 2u) << text;
+  EXPECT_NE(text.find("  not excited by this run: needs d_vx (accelerate, brake) (300 rows; --json has the numbers)"),
+            std::string::npos) << text;
+  const auto json = nlohmann::json::parse(report::estimate_json(t));
+  EXPECT_EQ(json["not_excited"], "needs d_vx (accelerate, brake)");
+  EXPECT_DOUBLE_EQ(json["parameters"][0]["value"].get<double>(), 160.0);
+  EXPECT_EQ(json["parameters"][1]["status"], "not excited");
+
+  t.not_excited.clear();
+  const std::string table_text = report::format_estimate_text(t);
+  EXPECT_NE(table_text.find("not excited        not excited: std 0.96 m^2 >= 0.7 m^2"), std::string::npos)
+      << table_text;  // status, then its reason
+}
+
+dds::Reply status_reply(std::uint32_t shard, std::uint32_t count, const std::string& payload) {
+  dds::Reply r;
+  r.payload_format = "application/json";
+  r.payload = payload;
+  r.shard = shard;
+  r.shard_count = count;
+  return r;
+}
+
+TEST(StatusText, OneCounterPerLineWithWhatItCounts) {
+  cli::ShardReplies one;
+  one.add(status_reply(0, 0, R"({"chunks_stored":40,"chunks_folded":40,"future_counter":3})"));
+  const std::string text = cli::status_text(one);
+  EXPECT_EQ(text.find('{'), std::string::npos) << text;
+  EXPECT_NE(text.find("chunks stored durably (acknowledged)"), std::string::npos) << text;
+  EXPECT_NE(text.find("chunks folded into estimates"), std::string::npos) << text;
+  EXPECT_NE(text.find("future_counter"), std::string::npos) << text;  // unknown: by its name
+  EXPECT_EQ(cli::line_count(text), 3u) << text;
+
+  cli::ShardReplies two;
+  two.add(status_reply(1, 2, R"({"chunks_stored":7})"));
+  const std::string partial = cli::status_text(two);
+  EXPECT_NE(partial.find("shard 1/2\n  chunks stored durably"), std::string::npos) << partial;
+  EXPECT_NE(partial.find("shard 0/2: did not answer"), std::string::npos) << partial;
+}
+
+}  // namespace
+}  // namespace dynid::test
