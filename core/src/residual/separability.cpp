@@ -1,7 +1,7 @@
 #include "dynid/residual/separability.hpp"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -11,7 +11,7 @@ namespace {
 std::string separating_manoeuvre(const model::Model& model, const CandidateScore& c, const std::string& parameter) {
   for (const model::Effect& e : model.candidate_effects())
     if (e.name == c.effect && !e.separated_by.empty()) return e.separated_by;
-  return "a run in which " + c.effect + "'s column varies apart from what " + parameter + " multiplies";
+  return "a run in which " + c.effect + "'s column varies apart from the column of " + parameter;
 }
 
 // The declared parameter that the undetectable effect moves most, in its standard deviations.
@@ -39,7 +39,7 @@ std::optional<Inseparable> worst_shift(const model::Model& model, const ScreenRe
 std::string Inseparable::statement() const {
   char buf[512];
   if (!identifiable) {
-    std::snprintf(buf, sizeof buf, "%s cannot be separated on this run: its column is a combination of the declared ones; %s",
+    std::snprintf(buf, sizeof buf, "%s cannot be separated on this run: its column is a combination of the declared ones; to separate it: %s",
                   effect.c_str(), separated_by.c_str());
     return buf;
   }
@@ -63,7 +63,7 @@ std::vector<Inseparable> inseparable_effects(const model::Model& model, const Sc
     if (!c.testable) {
       found = Inseparable{};
       found->identifiable = false;
-      found->separated_by = separating_manoeuvre(model, c, "the declared parameters");
+      found->separated_by = separating_manoeuvre(model, c, "every declared parameter");
     } else {
       found = worst_shift(model, screen, c);
     }
