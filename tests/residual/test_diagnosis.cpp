@@ -13,6 +13,8 @@
 #include "dynid/residual/effect_comparison.hpp"
 #include "dynid/residual/signal_delay.hpp"
 #include "dynid/residual/trace.hpp"
+#include "dynid/residual/varying_parameter.hpp"
+#include "dynid/error.hpp"
 
 namespace dynid::residual {
 namespace {
@@ -174,6 +176,34 @@ TEST(Diagnosis, ADriftingOffsetIsExplainedByItsDrift) {
   ASSERT_EQ(c.parameters.back().name, "sensor_offset_drift");
   EXPECT_EQ(c.parameters.back().unit, "m/s^2/s");
   EXPECT_NEAR(c.parameters.back().after, 0.4 / 60.0, 4.0 * c.parameters.back().std_after);
+}
+
+// A sensor scale that grows with the speed (a parameter that depends on a channel): explained
+// by depends:sensor_scale~vx, its slope recovered in the parameter's unit per unit of vx.
+TEST(Diagnosis, AParameterThatDependsOnAChannelIsExplainedByTheDependence) {
+  auto run = kinematic_run(17, 0.0);
+  const auto clean = kinematic_run(17, 0.0);
+  double mean = 0.0;
+  for (Eigen::Index k = 0; k < run.samples.rows(); ++k) mean += smooth(static_cast<double>(k) / kRate);
+  mean /= static_cast<double>(run.samples.rows());
+  for (Eigen::Index k = 0; k < run.samples.rows(); ++k) {
+    const double t = static_cast<double>(k) / kRate;
+    const double dv = 4.0 * 0.21 * std::cos(0.21 * t) + 1.5 * 0.9 * std::cos(0.9 * t + 0.3);
+    run.samples(k, 1) += 0.05 * (smooth(t) - mean) * dv;  // the scale changes by 0.05 per m/s
+  }
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  DiagnosisOptions options;
+  options.screen.dependences = true;
+  const Diagnosis d = diagnose(*model, {}, run, options);
+  ASSERT_EQ(d.verdict, Verdict::kExplained) << d.statement();
+  EXPECT_EQ(d.accepted->effect, "depends:sensor_scale~vx") << d.statement();
+  const EffectComparison c = compare_effect(*model, {}, "depends:sensor_scale~vx", ingest::preprocess_offline(run),
+                                            kRate, run.announcement.preprocessing.odmf);
+  EXPECT_EQ(c.parameters.back().name, "sensor_scale_per_vx");
+  EXPECT_NEAR(c.parameters.back().after, 0.05, 4.0 * c.parameters.back().std_after);
+  EXPECT_EQ(diagnose(*model, {}, clean, options).verdict, Verdict::kAdequate);
+  EXPECT_THROW(parse_varying_effect("depends:sensor_scale~", *model), InputError);
+  EXPECT_THROW(parse_varying_effect("depends:nothing~vx", *model), InputError);
 }
 
 // A step of the sensor's scale at 30 s (a load change at a stop, a sensor re-mounted): located

@@ -65,6 +65,16 @@ std::vector<Candidate> dictionary_candidates(const model::Model& m,
   return out;
 }
 
+// The channels a parameter may depend on (depends:<p>~<ch>): the model's physics channels that
+// the run has, not its measured side (a parameter times a sensor of the very force it explains
+// would fit and mean nothing, as for the dictionary).
+std::vector<std::string> dependence_channels(const model::Model& m, const std::vector<ingest::PreprocessedSegment>& run) {
+  std::vector<std::string> out;
+  for (const std::string& c : physics_channels(m))
+    if (run.front().channels.has(c) && !contains(m.measured_side(), c)) out.push_back(c);
+  return out;
+}
+
 std::vector<Candidate> candidates_of(const model::Model& m, const std::vector<std::string>& declared,
                                      const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
                                      const ScreenOptions& options) {
@@ -75,8 +85,10 @@ std::vector<Candidate> candidates_of(const model::Model& m, const std::vector<st
     const double t_first = static_cast<double>(run.front().first) / sample_rate_hz;
     const double t_last =
         static_cast<double>(run.back().first + run.back().channels.samples() - 1) / sample_rate_hz;
+    const bool dependences = options.dependences || !options.only.empty();
     for (const std::string& name :
-         varying_candidates(m, t_first, t_last, options.fit.cross_validation.block_seconds))
+         varying_candidates(m, t_first, t_last, options.fit.cross_validation.block_seconds,
+                            dependences ? dependence_channels(m, run) : std::vector<std::string>{}))
       all.push_back({name, varying_parameter_info(parse_varying_effect(name, m), m).description,
                      CandidateKind::kVarying});
   }

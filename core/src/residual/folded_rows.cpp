@@ -104,6 +104,32 @@ RowSelection kept_rows(const model::Model& model, const std::vector<std::string>
   return out;
 }
 
+namespace {
+
+// The run mean (over valid samples) of each dependence's channel (varying_parameter.hpp); 0
+// for the other varying parameters. InputError when the run lacks the channel.
+std::vector<double> channel_means(const std::vector<VaryingParameter>& varying,
+                                  const std::vector<ingest::PreprocessedSegment>& run) {
+  std::vector<double> out(varying.size(), 0.0);
+  for (std::size_t v = 0; v < varying.size(); ++v) {
+    if (varying[v].kind != VaryingParameter::Kind::kChannel) continue;
+    double sum = 0.0;
+    double count = 0.0;
+    for (const ingest::PreprocessedSegment& seg : run) {
+      if (!seg.channels.has(varying[v].channel))
+        throw InputError("effect 'depends:" + varying[v].parameter + "~" + varying[v].channel + "': the run has no channel '" +
+                         varying[v].channel + "'");
+      const Eigen::VectorXd& x = seg.channels[varying[v].channel];
+      for (Eigen::Index k = 0; k < x.size(); ++k)
+        if (seg.channels.valid(k) && std::isfinite(x(k))) sum += x(k), count += 1.0;
+    }
+    out[v] = count > 0.0 ? sum / count : 0.0;
+  }
+  return out;
+}
+
+}  // namespace
+
 FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& effects,
                      const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
                      int odmf, const FitOptions& options, bool collect, const RowSelection* only) {
@@ -174,6 +200,7 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   const std::vector<ingest::PreprocessedSegment> delayed_run = delays.empty() ? std::vector<ingest::PreprocessedSegment>{}
                                                                              : delayed(run, delays);
   const std::vector<ingest::PreprocessedSegment>& rows_run = delays.empty() ? run : delayed_run;
+  const std::vector<double> centres = channel_means(varying, rows_run);
   for (std::size_t s = 0; s < rows_run.size(); ++s) {
     const ingest::PreprocessedSegment& seg = rows_run[s];
     const std::vector<Eigen::Index> kept = decimation_grid(seg, odmf);
@@ -192,9 +219,13 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
           row[static_cast<std::size_t>(j)] = gr.W(static_cast<Eigen::Index>(i), j);
         const Eigen::Index grid_at = seg.first + sample;
         const double time_at = static_cast<double>(grid_at) / sample_rate_hz;
-        for (std::size_t v = 0; v < varying.size(); ++v)
+        for (std::size_t v = 0; v < varying.size(); ++v) {
+          const double centred = varying[v].kind == VaryingParameter::Kind::kChannel
+                                     ? seg.channels[varying[v].channel](sample) - centres[v]
+                                     : 0.0;
           row[static_cast<std::size_t>(model_width) + v] =
-              varying_column(varying[v], gr.W(static_cast<Eigen::Index>(i), varying[v].column), time_at, t_mid);
+              varying_column(varying[v], gr.W(static_cast<Eigen::Index>(i), varying[v].column), time_at, t_mid, centred);
+        }
         if (profile)
           profile->hats(profile->distance(s, sample),
                         row.data() + varying_end + static_cast<Eigen::Index>(g) * profile->knots());

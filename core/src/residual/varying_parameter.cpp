@@ -11,6 +11,7 @@ namespace {
 
 constexpr const char* kDrift = "drift:";
 constexpr const char* kStep = "step:";
+constexpr const char* kDepends = "depends:";
 
 bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
@@ -29,7 +30,9 @@ std::string seconds(double t) {
 
 }  // namespace
 
-bool is_varying_effect(const std::string& name) { return starts_with(name, kDrift) || starts_with(name, kStep); }
+bool is_varying_effect(const std::string& name) {
+  return starts_with(name, kDrift) || starts_with(name, kStep) || starts_with(name, kDepends);
+}
 
 VaryingParameter parse_varying_effect(const std::string& name, const model::Model& model) {
   VaryingParameter v;
@@ -38,7 +41,19 @@ VaryingParameter parse_varying_effect(const std::string& name, const model::Mode
     v.column = column_of(model, v.parameter, name);
     return v;
   }
-  if (!starts_with(name, kStep)) throw InputError("effect '" + name + "' is not drift:<parameter> nor step:<parameter>@<t>s");
+  if (starts_with(name, kDepends)) {
+    const std::string rest = name.substr(std::string(kDepends).size());
+    const auto tilde = rest.find('~');
+    if (tilde == std::string::npos || tilde + 1 == rest.size())
+      throw InputError("effect '" + name + "': expected depends:<parameter>~<channel>");
+    v.kind = VaryingParameter::Kind::kChannel;
+    v.parameter = rest.substr(0, tilde);
+    v.channel = rest.substr(tilde + 1);
+    v.column = column_of(model, v.parameter, name);
+    return v;
+  }
+  if (!starts_with(name, kStep))
+    throw InputError("effect '" + name + "' is not drift:<parameter>, step:<parameter>@<t>s nor depends:<parameter>~<channel>");
   const std::string rest = name.substr(std::string(kStep).size());
   const auto at = rest.rfind('@');
   if (at == std::string::npos || rest.size() < at + 3 || rest.back() != 's')
@@ -58,24 +73,31 @@ model::ParameterInfo varying_parameter_info(const VaryingParameter& v, const mod
   if (v.kind == VaryingParameter::Kind::kDrift)
     return {p.name + "_drift", p.unit + "/s", "rate of change of " + p.name + " over the run (the parameter is its mid-run value)",
             std::nullopt};
+  if (v.kind == VaryingParameter::Kind::kChannel)
+    return {p.name + "_per_" + v.channel, p.unit + " per unit of " + v.channel,
+            "change of " + p.name + " per unit of " + v.channel + " (the parameter is its value at " + v.channel +
+                "'s run mean)",
+            std::nullopt};
   return {p.name + "_step@" + seconds(v.step_time_s) + "s", p.unit,
           "change of " + p.name + " at " + seconds(v.step_time_s) + " s (the parameter is its value before)",
           std::nullopt};
 }
 
 std::vector<std::string> varying_candidates(const model::Model& model, double t_first, double t_last,
-                                            double block_s) {
+                                            double block_s, const std::vector<std::string>& channels) {
   std::vector<std::string> out;
   for (const model::ParameterInfo& p : model.parameters()) {
     out.push_back(kDrift + p.name);
+    for (const std::string& c : channels) out.push_back(kDepends + p.name + "~" + c);
     for (double t0 = (std::floor(t_first / block_s) + 2.0) * block_s; t0 <= t_last - block_s; t0 += block_s)
       out.push_back(kStep + p.name + "@" + seconds(t0) + "s");
   }
   return out;
 }
 
-double varying_column(const VaryingParameter& v, double w, double t, double t_mid) {
+double varying_column(const VaryingParameter& v, double w, double t, double t_mid, double centred) {
   if (v.kind == VaryingParameter::Kind::kDrift) return w * (t - t_mid);
+  if (v.kind == VaryingParameter::Kind::kChannel) return w * centred;
   return t >= v.step_time_s ? w : 0.0;
 }
 

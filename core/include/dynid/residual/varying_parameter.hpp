@@ -7,9 +7,16 @@
 //                                                    parameter itself its value at mid-run
 //   step:<parameter>@<t0>s     W_j [t >= t0]        the parameter changes at t0 (s of run time);
 //                                                    its coefficient is the change
-// The residual screen offers a drift of every parameter of the model and a step at every
-// cross-validation block boundary but the first and the last (a step needs data on both sides);
-// a step found is reported as a time. The column enters every equation group where W_j does.
+//   depends:<parameter>~<ch>   W_j (x - x_mean)     the parameter depends on channel x (a
+//                                                    cornering stiffness on the load, an offset
+//                                                    on the engine speed: "a model column times a
+//                                                    channel"); its coefficient is the change per
+//                                                    unit of x, the parameter its value at x's
+//                                                    run mean
+// The residual screen offers a drift of every parameter of the model, a step at every
+// cross-validation block boundary but the first and the last (a step needs data on both sides),
+// and a dependence of every parameter on every channel of the model's physics that is not on
+// its measured side; a step found is reported as a time. The column enters every equation group where W_j does.
 // On a run at nearly constant speed a drift or step of an offset and a road profile (a function
 // of distance) explain the same residual: the screen prefers the profile within one standard
 // error (effect_screen.hpp).
@@ -22,26 +29,29 @@
 namespace dynid::residual {
 
 struct VaryingParameter {
-  enum class Kind { kDrift, kStep } kind = Kind::kDrift;
+  enum class Kind { kDrift, kStep, kChannel } kind = Kind::kDrift;
   std::string parameter;
   Eigen::Index column = 0;  ///< the parameter's column in the model's rows
   double step_time_s = 0.0; ///< kStep: t0
+  std::string channel;      ///< kChannel: x
 };
 
 bool is_varying_effect(const std::string& name);
 
 /// Parses `name` against `model`'s parameters. InputError naming the effect when the form is
-/// wrong, the parameter unknown, or t0 not a finite number.
+/// wrong, the parameter unknown, t0 not a finite number, or the channel name empty.
 VaryingParameter parse_varying_effect(const std::string& name, const model::Model& model);
 
 /// The parameter the effect adds (no physical bounds: a change may have either sign).
 model::ParameterInfo varying_parameter_info(const VaryingParameter& v, const model::Model& model);
 
-/// The names the screen tries on a run spanning [t_first, t_last] s with blocks of `block_s`.
+/// The names the screen tries on a run spanning [t_first, t_last] s with blocks of `block_s`,
+/// a dependence on each of `channels`.
 std::vector<std::string> varying_candidates(const model::Model& model, double t_first, double t_last,
-                                            double block_s);
+                                            double block_s, const std::vector<std::string>& channels = {});
 
-/// The column's value on a row of W_j = `w`, at run time t, for a run whose middle is t_mid.
-double varying_column(const VaryingParameter& v, double w, double t, double t_mid);
+/// The column's value on a row of W_j = `w`, at run time t, for a run whose middle is t_mid;
+/// `centred` is x - x_mean of a kChannel's channel at that row (ignored otherwise).
+double varying_column(const VaryingParameter& v, double w, double t, double t_mid, double centred = 0.0);
 
 }  // namespace dynid::residual
