@@ -43,7 +43,7 @@
 // one-standard-error rule of cross-validated model choice (Hastie, Tibshirani and Friedman)
 // prefers the earlier kind, physics, road profile, signal timing, varying parameter,
 // dictionary: the best significant candidate of the first kind within one standard error of
-// the best one's held-out error (the paired difference of their per-fold log ratios) goes
+// the best one's held-out error (the standard error of its per-fold log ratios) goes
 // first. Physics is the simplest kind (each effect has a meaning and parameters an engineer can
 // use), not a tier above the rest:
 // - Why not physics first whatever its gain: on a car whose accelerometer is its only grade
