@@ -126,8 +126,10 @@ std::string json_run(const RunResult& r) {
   for (std::size_t i = 0; i < r.models.size(); ++i) {
     const ModelRun& m = r.models[i];
     o << (i ? "," : "") << "{\"model\":\"" << m.model << "\",\"first_verdict\":\"" << m.first_verdict
-      << "\",\"first_effect\":\"" << json_escape(m.first_effect) << "\",\"finding\":\"" << json_escape(m.first_finding)
-      << "\",\"ratio\":" << m.first_ratio << ",\"upper_ratio\":" << m.first_upper << ",\"added\":[";
+      << "\",\"first_effect\":\"" << json_escape(m.first_effect)
+      << "\",\"first_partial\":" << (m.first_partial ? "true" : "false") << ",\"finding\":\"" << json_escape(m.first_finding)
+      << "\",\"ratio\":" << m.first_ratio << ",\"upper_ratio\":" << m.first_upper
+      << ",\"ratio_after_first\":" << m.second_ratio << ",\"upper_ratio_after_first\":" << m.second_upper << ",\"added\":[";
     for (std::size_t k = 0; k < m.added.size(); ++k) o << (k ? "," : "") << "\"" << json_escape(m.added[k]) << "\"";
     o << "],\"stopped\":\"" << json_escape(m.stopped) << "\",\"signature\":\"" << json_escape(m.signature)
       << "\",\"bounds_ok\":" << (m.bounds_ok ? "true" : "false") << ",\"bounds_violations\":\""
@@ -147,7 +149,7 @@ std::string answer(const RunResult& r) {
   std::string out;
   for (const ModelRun& m : r.models) {
     if (!out.empty()) out += " + ";
-    out += m.first_effect.empty() ? m.first_verdict : m.first_effect;
+    out += m.first_effect.empty() ? m.first_verdict : m.first_effect + (m.first_partial ? " (part)" : "");
   }
   return out;
 }
@@ -160,6 +162,7 @@ void print_run(const RunResult& r) {
     std::printf("      %s: ratio %.2f (floor test up to %.2f), added [", m.model.c_str(), m.first_ratio, m.first_upper);
     for (std::size_t k = 0; k < m.added.size(); ++k) std::printf("%s%s", k ? ", " : "", m.added[k].c_str());
     std::printf("], %s", m.stopped.c_str());
+    if (m.second_upper > 0.0) std::printf("; after the first: ratio %.2f (up to %.2f)", m.second_ratio, m.second_upper);
     if (!m.first_finding.empty()) std::printf("; %s", m.first_finding.c_str());
     if (!m.signature.empty()) std::printf("; signature: %s", m.signature.c_str());
     if (!m.bounds_ok) std::printf("; OUT OF BOUNDS: %s", m.bounds_violations.c_str());

@@ -47,6 +47,7 @@ ModelRun trace_model(const RunSetup& setup, const std::string& name, const inges
   m.first_verdict = residual::verdict_name(first.verdict);
   if (first.accepted) {
     m.first_effect = first.accepted->effect;
+    m.first_partial = first.partial.has_value();
     m.first_finding = first.accepted->finding;
   }
   for (const residual::GroupFloor& g : first.floor.groups)
@@ -55,6 +56,12 @@ ModelRun trace_model(const RunSetup& setup, const std::string& name, const inges
       m.first_upper = g.upper_ratio;
     }
   for (const residual::Inseparable& i : first.inseparable) m.first_inseparable.push_back(i.effect);
+  if (t.rounds.size() > 1)
+    for (const residual::GroupFloor& g : t.rounds[1].diagnosis.floor.groups)
+      if (g.rows > 0 && g.ratio / g.upper_ratio > m.second_ratio / std::max(m.second_upper, 1e-300)) {
+        m.second_ratio = g.ratio;
+        m.second_upper = g.upper_ratio;
+      }
   if (first.verdict == residual::Verdict::kStructureLeft) m.signature = signature_text(first.signature);
   if (setup.verbose) {
     m.report = report::format_diagnosis_text(first, 8);
@@ -180,8 +187,10 @@ RunResult run_family(const RunSetup& setup, const Family& family, std::uint64_t 
       const bool reported = std::any_of(m.first_inseparable.begin(), m.first_inseparable.end(),
                                         [&](const std::string& e) { return family.right(e, draw); });
       r.outcome = reported && family.inseparable_is_right ? Outcome::kInseparable : Outcome::kMissed;
-    } else if (m.first_verdict == "structure left") {
-      r.outcome = family.expect == Expect::kStructureLeft ? Outcome::kStructureRight : Outcome::kStructureMissed;
+    } else if (m.first_verdict == "structure left" && family.expect == Expect::kStructureLeft) {
+      r.outcome = Outcome::kStructureRight;
+    } else if (m.first_verdict == "structure left" && m.first_effect.empty()) {
+      r.outcome = Outcome::kStructureMissed;
     } else if (family.right(m.first_effect, draw)) {
       r.outcome = Outcome::kRight;
     } else if (family.proxy(m.first_effect, draw)) {

@@ -25,10 +25,13 @@ bool is_right(Outcome o);
 struct ModelRun {
   std::string model;
   std::string first_verdict;  ///< the loop's first diagnosis
-  std::string first_effect;   ///< its accepted candidate ("" unless explained)
+  std::string first_effect;   ///< its accepted candidate ("" when none)
+  bool first_partial = false; ///< that candidate explains a part only (verdict "structure left")
   std::string first_finding;  ///< e.g. "vx is 120 +- 3 ms late"
   double first_ratio = 0.0;   ///< residual / floor (ratio of squares), worst group
   double first_upper = 0.0;   ///< the floor test's critical ratio there
+  double second_ratio = 0.0;  ///< the same after the first added effect (0 when none was added)
+  double second_upper = 0.0;
   std::vector<std::string> added;
   std::string stopped;
   std::string signature;      ///< the first diagnosis' strongest correlations, when structure is left

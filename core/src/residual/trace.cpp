@@ -41,7 +41,8 @@ Trace trace(const model::Model& model, const std::vector<std::string>& declared,
   for (int round = 0;; ++round) {
     TraceRound r{effects, diagnose(model, effects, run, segments, options.diagnosis), std::nullopt};
     const Verdict verdict = r.diagnosis.verdict;
-    if (verdict != Verdict::kExplained) {
+    // A partial explanation is added like a full one: what it leaves may be a second effect.
+    if (!r.diagnosis.accepted) {
       t.stopped = std::string(verdict_name(verdict)) + " after " + std::to_string(round) + " added effect" +
                   (round == 1 ? "" : "s");
       t.rounds.push_back(std::move(r));

@@ -217,6 +217,11 @@ json diagnosis_object(const residual::Diagnosis& d) {
           {"verdict", residual::verdict_name(d.verdict)},
           {"statement", d.statement()},
           {"accepted", d.accepted ? json(d.accepted->effect) : json(nullptr)},
+          // The accepted candidate explains a part only: its model stays above its own floor.
+          {"partial", d.partial ? json({{"group", d.partial->group},
+                                        {"ratio", finite(d.partial->ratio)},
+                                        {"upper_ratio", finite(d.partial->upper_ratio)}})
+                                : json(nullptr)},
           {"floor", {{"groups", groups}, {"channels", noise}, {"contributing", d.floor.contributing}}},
           {"candidate_level", finite(d.screen.level)},
           {"candidates", candidates},

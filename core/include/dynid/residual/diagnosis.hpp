@@ -5,7 +5,9 @@
 //   explained       above the floor, and a candidate effect is significant (effect_screen.hpp).
 //   structure left  above the floor, and no candidate explains it: its signature says where to
 //                   look (which channel and lag the residual correlates with, which time span of
-//                   the run holds the most of it, which frequency).
+//                   the run holds the most of it, which frequency). A significant candidate whose
+//                   own model stays above its own floor explains a part only: it is named as such
+//                   (Diagnosis::partial) and the verdict stays "structure left".
 //
 // The order is a closed test, so that the chance of an alarm on a run whose model lacks nothing
 // is stated: the floor test comes first, at level floor.error_rate (default 0.05: at most one
@@ -75,8 +77,13 @@ struct RefusedCandidate {
 struct Diagnosis {
   NoiseFloor floor;
   ScreenResult screen;
-  /// The significant candidate that explains the residual (kExplained only).
+  /// The significant candidate the loop adds next: it explains the residual (kExplained), or a
+  /// part of it (kStructureLeft with `partial` set).
   std::optional<CandidateScore> accepted;
+  /// Set when the accepted candidate's model stays above its own noise floor: its group furthest
+  /// above (ratio / upper_ratio). The verdict is then "structure left", the accepted candidate
+  /// the part of it that can be explained.
+  std::optional<GroupFloor> partial;
   std::vector<RefusedCandidate> refused;  ///< significant candidates refused, with the reason
   Signature signature;
   /// Physical effects this run cannot rule out although they would bias the declared
