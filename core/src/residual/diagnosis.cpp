@@ -223,6 +223,27 @@ std::vector<std::string> sensors_of(const CandidateScore& c, const std::vector<m
   return {};
 }
 
+// Why `c` is implausible before any fit of its own: the omitted-variable identity (CandidateScore::
+// alias) gives the declared parameters with it, x_with = x_without - alias c, and their std,
+// sqrt(std_without^2 + alias^2 std_c^2) (the restricted estimate and the added coefficient are
+// uncorrelated); the candidate's own coefficient is held to its effect's bounds. Empty when
+// nothing leaves its bounds, or for a candidate of several columns (the trace checks every
+// candidate it adds on its own fit: trace.cpp).
+std::string bounds_refusal(const CandidateScore& c, const ModelFit& fit, const std::vector<model::Effect>& effects) {
+  if (c.alias.size() != fit.parameters.size() || !std::isfinite(c.coefficient)) return {};
+  for (std::size_t j = 0; j < fit.parameters.size(); ++j) {
+    const auto i = static_cast<Eigen::Index>(j);
+    const double with = fit.estimate.value(i) - c.alias[j] * c.coefficient;
+    const double std = std::hypot(fit.estimate.standard_deviation(i), c.alias[j] * c.coefficient_std);
+    if (std::string why = out_of_bounds(fit.parameters[j], with, std); !why.empty()) return "it takes " + why;
+  }
+  for (const model::Effect& e : effects)
+    if (e.name == c.effect && e.parameters.size() == 1)
+      if (std::string why = out_of_bounds(e.parameters.front(), c.coefficient, c.coefficient_std); !why.empty())
+        return "its own coefficient " + why;
+  return {};
+}
+
 // What the floor of a candidate's model needs.
 struct FloorInputs {
   const model::Model& model;
@@ -308,6 +329,10 @@ void accept_best(Diagnosis& d, const FloorInputs& in) {
     const auto same = std::find_first_of(sensors.begin(), sensors.end(), refused_sensors.begin(), refused_sensors.end());
     if (same != sensors.end()) {
       d.refused.push_back({c.effect, "reads " + *same + ", the sensor refused above as a better sensor of a declared signal"});
+      continue;
+    }
+    if (std::string why = bounds_refusal(c, d.screen.fit, effects); !why.empty()) {
+      d.refused.push_back({c.effect, why});
       continue;
     }
     const OwnFloor own = own_floor(c, in, d.floor);
