@@ -315,17 +315,29 @@ OwnFloor own_floor(const CandidateScore& c, const FloorInputs& in, const NoiseFl
 // floor test's level is the chance that a candidate that explains everything is called partial
 // (0.05); measured on bench/trace, every effect no family expresses (tyre relaxation, backlash,
 // gusts) left its best candidate's model 1.3 to 4 times above its floor.
-void accept_best(Diagnosis& d, const FloorInputs& in) {
+//
+// At the declared floor (`at_floor`), only better sensors are weighed, each sensor through the
+// first candidate that reads it: a missing effect read through the declared sensors shares
+// their floor and cannot show what their noise hides.
+void accept_best(Diagnosis& d, const FloorInputs& in, bool at_floor = false) {
   const std::vector<model::Effect> effects = in.model.candidate_effects();
-  std::vector<std::string> refused_sensors;
+  std::vector<std::string> refused_sensors, judged_sensors;
   std::vector<CandidateScore> missing, sensors_better;
   std::map<std::string, OwnFloor> floors;
   for (const CandidateScore& c : d.screen.candidates) {
     if (!c.significant) break;  // ranked: the significant ones come first
     // Past the first missing effect, only an earlier kind can move ahead of it (the one-error
     // rule): the others need no floor of their own.
-    if (!missing.empty() && static_cast<int>(c.kind) >= static_cast<int>(missing.front().kind)) continue;
+    if (!at_floor && !missing.empty() && static_cast<int>(c.kind) >= static_cast<int>(missing.front().kind)) continue;
     const std::vector<std::string> sensors = sensors_of(c, effects);
+    if (at_floor) {
+      // A sensor is judged by its best use, the first candidate in the ranking that reads it
+      // (the accelerometer, not its lag, which leaves structure of its own).
+      if (sensors.empty() || std::find_first_of(sensors.begin(), sensors.end(), judged_sensors.begin(),
+                                                judged_sensors.end()) != sensors.end())
+        continue;
+      judged_sensors.insert(judged_sensors.end(), sensors.begin(), sensors.end());
+    }
     const auto same = std::find_first_of(sensors.begin(), sensors.end(), refused_sensors.begin(), refused_sensors.end());
     if (same != sensors.end()) {
       d.refused.push_back({c.effect, "reads " + *same + ", the sensor refused above as a better sensor of a declared signal"});
@@ -344,6 +356,7 @@ void accept_best(Diagnosis& d, const FloorInputs& in) {
     (own.lowers ? sensors_better : missing).push_back(c);
     floors.emplace(c.effect, own);
   }
+  if (at_floor) missing.clear();
   std::vector<CandidateScore>& chosen = missing.empty() ? sensors_better : missing;
   if (chosen.empty()) return;
   prefer_simplest_within_one_error(chosen);
@@ -410,7 +423,9 @@ std::string Diagnosis::verdict_statement() const {
     case Verdict::kStructureLeft:
       break;
   }
-  out = "structure left that no candidate explains: above the noise floor (" + floors + ")";
+  out = masked ? "structure left under the declared signals' noise: the residual is at the noise floor (" + floors +
+                    "), but with " + accepted->effect + " the model's own, lower floor shows what that noise hid"
+               : "structure left that no candidate explains: above the noise floor (" + floors + ")";
   if (accepted && partial)
     out += "; " + accepted->effect + " (" + kind_name(accepted->kind) +
            (accepted->finding.empty() ? "" : ": " + accepted->finding) + ") explains a part of it: held-out RMS " +
@@ -460,12 +475,24 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
   floor_options.fit = options.screen.fit;
   const std::vector<ChannelNoise> noise = measure_channel_noise(run, segments, options.declared_noise);
   d.floor = noise_floor(model, declared, run, segments, noise, floor_options);
+  const FloorInputs floor_inputs{model, declared, run, segments, noise, floor_options};
   if (d.floor.adequate()) {
-    d.verdict = Verdict::kAdequate;
-    d.inseparable = inseparable_effects(model, d.screen);
-    return d;
+    // Structure hidden under the declared signals' noise (diagnosis.hpp): the candidate the loop
+    // would accept, when its model stays above its own floor.
+    Diagnosis probe = d;
+    accept_best(probe, floor_inputs, /*at_floor=*/true);
+    if (!(probe.accepted && probe.partial)) {
+      d.verdict = Verdict::kAdequate;
+      d.inseparable = inseparable_effects(model, d.screen);
+      return d;
+    }
+    d.accepted = std::move(probe.accepted);
+    d.partial = std::move(probe.partial);
+    d.refused = std::move(probe.refused);
+    d.masked = true;
+  } else {
+    accept_best(d, floor_inputs);
   }
-  accept_best(d, {model, declared, run, segments, noise, floor_options});
   d.inseparable = inseparable_effects(model, d.screen, d.accepted ? d.accepted->effect : "");
   d.verdict = d.accepted && !d.partial ? Verdict::kExplained : Verdict::kStructureLeft;
   const SignatureInputs in{model, segments, d.screen.fit, d.floor, rate, odmf,

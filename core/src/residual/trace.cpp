@@ -1,21 +1,35 @@
 #include "dynid/residual/trace.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "dynid/error.hpp"
 
 namespace dynid::residual {
 namespace {
 
+std::string four_digits(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
 // Why adding the accepted candidate is refused, or empty when it is not.
 std::string refusal(const EffectComparison& c) {
   if (!(c.held_out_drop() > 0.0))
     return c.effect + " refused: with it the held-out residual is not lower (" +
            std::to_string(100.0 * -c.held_out_drop()) + " %)";
-  for (std::size_t i = 0; i < c.parameters.size() && i < c.after.parameters.size(); ++i)
-    if (const std::string why = out_of_bounds(c.after.parameters[i], c.parameters[i].after, c.parameters[i].std_after);
-        !why.empty())
+  for (std::size_t i = 0; i < c.parameters.size() && i < c.after.parameters.size(); ++i) {
+    const ParameterChange& p = c.parameters[i];
+    const model::ParameterInfo& info = c.after.parameters[i];
+    if (const std::string why = out_of_bounds(info, p.after, p.std_after); !why.empty())
       return c.effect + " refused: it takes " + why;
+    // A value the model held within its bounds and the candidate takes out of them, whatever its
+    // std: the candidate absorbs that parameter (a loop must not end on an impossible value).
+    if (std::isfinite(p.before) && info.within_bounds(p.before) && std::isfinite(p.after) && !info.within_bounds(p.after))
+      return c.effect + " refused: it takes " + info.name + " from " + four_digits(p.before) + " to " +
+             four_digits(p.after) + " " + info.unit + ", outside its physical bounds (" + info.bounds_text() + ")";
+  }
   return {};
 }
 

@@ -220,7 +220,8 @@ json diagnosis_object(const residual::Diagnosis& d) {
           // The accepted candidate explains a part only: its model stays above its own floor.
           {"partial", d.partial ? json({{"group", d.partial->group},
                                         {"ratio", finite(d.partial->ratio)},
-                                        {"upper_ratio", finite(d.partial->upper_ratio)}})
+                                        {"upper_ratio", finite(d.partial->upper_ratio)},
+                                        {"masked", d.masked}})
                                 : json(nullptr)},
           {"floor", {{"groups", groups}, {"channels", noise}, {"contributing", d.floor.contributing}}},
           {"candidate_level", finite(d.screen.level)},
