@@ -33,9 +33,13 @@ void print_seed(const SeedRun& r) {
   std::printf("%-12s seed %llu (%.1f s)", benchcar::manoeuvre_name(r.manoeuvre), static_cast<unsigned long long>(r.seed),
               r.seconds);
   if (!r.error.empty()) std::printf(" ERROR: %s", r.error.c_str());
-  for (const ParameterSample& s : r.samples)
-    std::printf("; %s %+.2f %% (std %.2f, HAC %.2f)", s.parameter.c_str(), 100.0 * s.relative_error(),
+  const std::string* model = nullptr;  // named once before its parameters: two models share names
+  for (const ParameterSample& s : r.samples) {
+    if (model == nullptr || *model != s.model) std::printf("; %s:", s.model.c_str());
+    model = &s.model;
+    std::printf(" %s %+.2f %% (std %.2f, HAC %.2f)", s.parameter.c_str(), 100.0 * s.relative_error(),
                 100.0 * s.std / std::abs(s.truth), 100.0 * s.hac_std / std::abs(s.truth));
+  }
   std::printf("\n");
   std::fflush(stdout);
 }
@@ -45,7 +49,7 @@ std::vector<SeedRun> measure_all(const Options& o, const car::VehicleProfile& pr
   std::vector<SeedRun> runs;
   for (benchcar::Manoeuvre m : o.manoeuvres)
     for (int s = 1; s <= o.seeds; ++s) {
-      runs.push_back(measure_seed(profile, m, 1000 + static_cast<std::uint64_t>(s), work_dir));
+      runs.push_back(measure_seed(profile, m, 1000 + static_cast<std::uint64_t>(s), o.noise_scale, work_dir));
       print_seed(runs.back());
     }
   return runs;
@@ -70,8 +74,8 @@ int main(int argc, char** argv) {
     return failures == 0 ? 0 : 1;
   }
   const auto start = std::chrono::steady_clock::now();
-  std::printf("dynid-bench-coverage: %d clean runs per manoeuvre (seeds 1001-%d), the car's sensor noise\n", o.seeds,
-              1000 + o.seeds);
+  std::printf("dynid-bench-coverage: %d clean runs per manoeuvre (seeds 1001-%d), the car's sensor noise x %g\n",
+              o.seeds, 1000 + o.seeds, o.noise_scale);
   const std::vector<SeedRun> runs = measure_all(o, profile, work_dir);
   std::filesystem::remove_all(work_dir);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

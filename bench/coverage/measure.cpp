@@ -54,13 +54,13 @@ const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre) {
 }
 
 SeedRun measure_seed(const car::VehicleProfile& profile, benchcar::Manoeuvre manoeuvre, std::uint64_t seed,
-                     const std::filesystem::path& work_dir) {
+                     double noise_scale, const std::filesystem::path& work_dir) {
   const auto t0 = std::chrono::steady_clock::now();
   SeedRun r;
   r.manoeuvre = manoeuvre;
   r.seed = seed;
   try {
-    const benchcar::CleanRun run = benchcar::clean_run(profile, manoeuvre, seed, 1.0, work_dir);
+    const benchcar::CleanRun run = benchcar::clean_run(profile, manoeuvre, seed, noise_scale, work_dir);
     for (const std::string& model : models_of(manoeuvre)) add_model(profile, model, run, r.samples);
   } catch (const std::exception& e) {
     r.error = e.what();

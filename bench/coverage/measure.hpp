@@ -42,8 +42,9 @@ struct SeedRun {
 /// The models identified on a manoeuvre (docs/RESIDUAL.md "Benchmark on a second car").
 const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre);
 
-/// One clean run at `seed` and its fits. Never throws: a failure is SeedRun::error.
+/// One clean run at `seed` (sensor noise times noise_scale) and its fits. Never throws: a failure
+/// is SeedRun::error.
 SeedRun measure_seed(const car::VehicleProfile& profile, benchcar::Manoeuvre manoeuvre, std::uint64_t seed,
-                     const std::filesystem::path& work_dir);
+                     double noise_scale, const std::filesystem::path& work_dir);
 
 }  // namespace dynid::benchcoverage

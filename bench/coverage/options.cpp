@@ -10,7 +10,7 @@ namespace {
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr,
                "%s\nusage: dynid-bench-coverage [--seeds N] [--manoeuvres longitudinal,lateral,launch] [--json FILE]\n"
-               "                            [--profile TOML] [--smoke]\n",
+               "                            [--noise SCALE] [--profile TOML] [--smoke]\n",
                why.c_str());
   std::exit(2);
 }
@@ -20,6 +20,13 @@ int seeds_of(const std::string& text) {
   const long n = std::strtol(text.c_str(), &end, 10);
   if (end == text.c_str() || *end != '\0' || n < 1 || n > 1000) usage("--seeds: expected an integer in [1, 1000]");
   return static_cast<int>(n);
+}
+
+double noise_of(const std::string& text) {
+  char* end = nullptr;
+  const double x = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !(x >= 0.0 && x <= 10.0)) usage("--noise: expected a number in [0, 10]");
+  return x;
 }
 
 // Only the three manoeuvres the models are identified on: cruise is the smoke test's exactness run.
@@ -48,6 +55,7 @@ Options parse_options(int argc, char** argv) {
     };
     if (a == "--seeds") o.seeds = seeds_of(value());
     else if (a == "--manoeuvres") o.manoeuvres = manoeuvres_of(value());
+    else if (a == "--noise") o.noise_scale = noise_of(value());
     else if (a == "--json") o.json = value();
     else if (a == "--profile") o.profile = value();
     else if (a == "--smoke") o.smoke = true;

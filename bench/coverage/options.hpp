@@ -11,6 +11,7 @@ struct Options {
   int seeds = 20;  ///< clean runs per manoeuvre, seeds 1001 .. 1000 + seeds
   std::vector<benchcar::Manoeuvre> manoeuvres = {benchcar::Manoeuvre::kLongitudinal, benchcar::Manoeuvre::kLateral,
                                                  benchcar::Manoeuvre::kLaunch};
+  double noise_scale = 1.0;  ///< the car's sensor noise times this (0: noise-free, to tell noise from model error)
   std::string json;  ///< per-seed values, empty: none
   std::string profile = DYNID_BENCHCAR_PROFILE;
   bool smoke = false;

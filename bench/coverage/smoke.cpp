@@ -51,7 +51,7 @@ int run_smoke(const car::VehicleProfile& profile, const std::filesystem::path& w
   std::vector<SeedRun> runs;
   std::vector<std::string> failed;
   for (std::uint64_t seed : {1001u, 1002u}) {
-    runs.push_back(measure_seed(profile, benchcar::Manoeuvre::kLateral, seed, work_dir));
+    runs.push_back(measure_seed(profile, benchcar::Manoeuvre::kLateral, seed, 1.0, work_dir));
     for (const std::string& f : check_seed(runs.back())) failed.push_back(f);
   }
   const std::vector<ParameterCoverage> rows = summarize(runs);
