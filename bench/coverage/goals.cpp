@@ -20,9 +20,11 @@ std::string std_verdict(const char* which, const StdCoverage& c) {
 std::string accuracy_verdict(const ParameterCoverage& r) {
   const double goal = accuracy_goal_pct(r.parameter);
   if (std::isnan(goal)) return "no accuracy goal";
-  char b[160];
-  std::snprintf(b, sizeof b, "accuracy goal %.1f %%: mean error %+.2f %%, scatter %.2f %% -> %s", goal, r.mean_error_pct,
-                r.scatter_pct, std::abs(r.mean_error_pct) <= goal ? "mean within" : "mean OUTSIDE");
+  int within = 0;
+  for (double e : r.errors_pct) within += std::abs(e) <= goal ? 1 : 0;
+  char b[200];
+  std::snprintf(b, sizeof b, "accuracy goal %.1f %%: mean error %+.2f %% %s, %d of %d seeds within", goal,
+                r.mean_error_pct, std::abs(r.mean_error_pct) <= goal ? "within" : "OUTSIDE", within, r.seeds);
   return b;
 }
 

@@ -49,6 +49,7 @@ ParameterCoverage row_of(const std::vector<const ParameterSample*>& samples) {
     hac.push_back(100.0 * s->hac_std / std::abs(s->truth));
   }
   row.seeds = static_cast<int>(errors.size());
+  row.errors_pct = errors;
   row.mean_error_pct = mean(errors);
   row.scatter_pct = scatter(errors);
   row.table = coverage_of(errors, table);

@@ -24,6 +24,7 @@ struct ParameterCoverage {
   int seeds = 0;                 ///< seeds with a finite value and both std
   double mean_error_pct = kNaN;  ///< mean of (value - truth) / |truth|
   double scatter_pct = kNaN;     ///< the errors' std over the seeds (n - 1)
+  std::vector<double> errors_pct;  ///< seed by seed
   StdCoverage table;             ///< the estimate table's std
   StdCoverage hac;               ///< the HAC std
 };
