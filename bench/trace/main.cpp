@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "car/product_path.hpp"
+#include "command_line.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/residual/model_fit.hpp"
 #include "families.hpp"
@@ -58,37 +59,27 @@ struct Options {
 
 Options parse(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usage(a + " needs a value");
-      return argv[++i];
-    };
-    auto number = [&](double lo, double hi) {
-      const std::string v = value();
-      char* end = nullptr;
-      const double x = std::strtod(v.c_str(), &end);
-      if (end == v.c_str() || *end != '\0' || !(x >= lo && x <= hi)) usage(a + ": expected a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-      return x;
-    };
-    if (a == "--seeds") o.seeds = static_cast<int>(number(1, 1000));
-    else if (a == "--clean") o.clean = static_cast<int>(number(0, 1000));
+  bench::CommandLine args(argc, argv, usage);
+  while (args.next()) {
+    const std::string& a = args.option();
+    if (a == "--seeds") o.seeds = static_cast<int>(args.number(1, 1000));
+    else if (a == "--clean") o.clean = static_cast<int>(args.number(0, 1000));
     else if (a == "--families") {
-      std::stringstream ss(value());
+      std::stringstream ss(args.value());
       for (std::string f; std::getline(ss, f, ',');) o.families.push_back(f);
-    } else if (a == "--json") o.json = value();
-    else if (a == "--time-limit") o.time_limit_s = number(1, 86400);
-    else if (a == "--profile") o.profile = value();
+    } else if (a == "--json") o.json = args.value();
+    else if (a == "--time-limit") o.time_limit_s = args.number(1, 86400);
+    else if (a == "--profile") o.profile = args.value();
     else if (a == "--smoke") o.smoke = true;
     else if (a == "--verbose") o.verbose = true;
     else if (a == "--probe") {
-      o.probe_family = value();
-      o.probe = value();
+      o.probe_family = args.value();
+      o.probe = args.value();
     }
     else if (a == "--dump") {
-      o.dump = value();
-      o.dump_manoeuvre = value();
-    } else if (a == "--noise") o.noise_scale = number(0, 10);
+      o.dump = args.value();
+      o.dump_manoeuvre = args.value();
+    } else if (a == "--noise") o.noise_scale = args.number(0, 10);
     else if (a == "--help" || a == "-h") usage("");
     else usage("unknown option " + a);
   }

@@ -7,6 +7,8 @@
 #include <functional>
 #include <random>
 
+#include "car/clean_run.hpp"
+#include "car/declared_fit.hpp"
 #include "car/parameters.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/report/residual_report.hpp"
@@ -104,10 +106,6 @@ ModelRun trace_model(const RunSetup& setup, const std::string& name, const inges
   return m;
 }
 
-std::uint64_t family_seed(const std::string& name, std::uint64_t seed) {
-  return std::hash<std::string>{}(name) ^ (seed * 0x9e3779b97f4a7c15ULL);
-}
-
 // The product's consistency check (residual/consistency.hpp) over the run's models as declared:
 // shared parameters compared within their HAC std. Flagged: a significant disagreement.
 void cross_check(const RunSetup& setup, const std::vector<std::string>& models,
@@ -115,12 +113,7 @@ void cross_check(const RunSetup& setup, const std::vector<std::string>& models,
                  RunResult& r) {
   if (models.size() < 2) return;
   std::vector<residual::ModelParameters> fits;
-  for (const std::string& name : models) {
-    const ingest::ModelSpec spec = benchcar::model_spec(*setup.profile, name);
-    const auto model = model::make_model(spec.model, spec.constants);
-    fits.push_back(residual::hac_parameters(*model, spec.effects, segments, run.announcement.sample_rate_hz,
-                                            run.announcement.preprocessing.odmf));
-  }
+  for (const std::string& name : models) fits.push_back(benchcar::declared_hac(*setup.profile, name, run, segments));
   const residual::Consistency c = residual::check_consistency(fits, {});
   r.cross_checked = !c.comparisons.empty();
   r.cross_flagged = !c.consistent();
@@ -148,29 +141,20 @@ bool is_right(Outcome o) {
   return o == Outcome::kRight || o == Outcome::kProxy || o == Outcome::kStructureRight || o == Outcome::kInseparable;
 }
 
-residual::ModelFit declared_fit(const car::VehicleProfile& profile, const std::string& name, const ingest::RecordedRun& run) {
-  const ingest::ModelSpec spec = benchcar::model_spec(profile, name);
-  const auto model = model::make_model(spec.model, spec.constants);
-  residual::FitOptions options;
-  options.series = false;
-  return residual::fit_model(*model, spec.effects, ingest::preprocess_offline(run), run.announcement.sample_rate_hz,
-                             run.announcement.preprocessing.odmf, options);
-}
-
 RunResult run_family(const RunSetup& setup, const Family& family, std::uint64_t seed) {
   const auto t0 = std::chrono::steady_clock::now();
   RunResult r;
   r.family = family.name;
   r.seed = seed;
   try {
-    std::mt19937_64 rng(family_seed(family.name, seed));
+    std::mt19937_64 rng(benchcar::run_seed(family.name, seed));
     const Draw draw = family.draw(rng);
     r.drawn = draw.text;
     const benchcar::CarParameters car;
     const benchcar::Truth truth = benchcar::simulate(family.manoeuvre, car, draw.perturbation, seed);
     const std::string run_name = family.name + "-" + std::to_string(seed);
     const benchcar::ProductRun product = benchcar::through_product(
-        *setup.profile, truth, draw.perturbation, {setup.noise_scale, family_seed(run_name, seed)}, run_name, setup.work_dir);
+        *setup.profile, truth, draw.perturbation, {setup.noise_scale, benchcar::run_seed(run_name, seed)}, run_name, setup.work_dir);
     const auto segments = ingest::preprocess_offline(product.recorded);
     for (const std::string& m : family.models)
       r.models.push_back(trace_model(setup, m, product.recorded, segments, truth.parameters));
@@ -213,19 +197,13 @@ RunResult run_clean(const RunSetup& setup, benchcar::Manoeuvre manoeuvre, const 
   r.family = std::string("clean-") + benchcar::manoeuvre_name(manoeuvre);
   r.seed = seed;
   try {
-    const benchcar::CarParameters car;
-    const benchcar::Perturbation none;
-    const benchcar::Truth truth = benchcar::simulate(manoeuvre, car, none, seed);
-    const std::string run_name = r.family + "-" + std::to_string(seed);
-    const benchcar::ProductRun product = benchcar::through_product(
-        *setup.profile, truth, none, {setup.noise_scale, family_seed(run_name, seed)}, run_name, setup.work_dir);
-    const auto segments = ingest::preprocess_offline(product.recorded);
+    const benchcar::CleanRun run = benchcar::clean_run(*setup.profile, manoeuvre, seed, setup.noise_scale, setup.work_dir);
     bool alarm = false;
     for (const std::string& m : models) {
-      r.models.push_back(trace_model(setup, m, product.recorded, segments, truth.parameters));
+      r.models.push_back(trace_model(setup, m, run.product.recorded, run.segments, run.truth.parameters));
       alarm = alarm || r.models.back().first_verdict != "adequate";
     }
-    cross_check(setup, models, segments, product.recorded, r);
+    cross_check(setup, models, run.segments, run.product.recorded, r);
     r.outcome = alarm ? Outcome::kWrong : Outcome::kRight;
   } catch (const std::exception& e) {
     r.outcome = Outcome::kError;

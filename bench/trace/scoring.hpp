@@ -80,8 +80,4 @@ RunResult run_family(const RunSetup& setup, const Family& family, std::uint64_t 
 RunResult run_clean(const RunSetup& setup, benchcar::Manoeuvre manoeuvre, const std::vector<std::string>& models,
                     std::uint64_t seed);
 
-/// The model's own fit with its declared effects on a run (for the exactness checks).
-residual::ModelFit declared_fit(const car::VehicleProfile& profile, const std::string& model,
-                                const ingest::RecordedRun& run);
-
 }  // namespace dynid::benchtrace

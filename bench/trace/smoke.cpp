@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "car/declared_fit.hpp"
 #include "car/parameters.hpp"
 
 namespace dynid::benchtrace {
@@ -26,7 +27,7 @@ void recover(Check& check, const RunSetup& setup, benchcar::Manoeuvre manoeuvre,
   const benchcar::Truth truth = benchcar::simulate(manoeuvre, car, none, seed);
   const std::string name = std::string("smoke-") + benchcar::manoeuvre_name(manoeuvre) + (noise_scale == 0.0 ? "-quiet" : "-noisy");
   const benchcar::ProductRun run = benchcar::through_product(*setup.profile, truth, none, {noise_scale, seed}, name, setup.work_dir);
-  const residual::ModelFit fit = declared_fit(*setup.profile, model, run.recorded);
+  const residual::ModelFit fit = benchcar::declared_fit(*setup.profile, model, run.recorded);
   for (std::size_t i = 0; i < fit.parameters.size(); ++i) {
     const auto it = truth.parameters.find(fit.parameters[i].name);
     if (it == truth.parameters.end()) continue;

@@ -1,0 +1,87 @@
+// dynid-bench-coverage: do the reported standard deviations cover the error? (issue 16 item 3,
+// the measurement; docs/ACCURACY.md "Coverage of the standard deviations (second car)"). For
+// every manoeuvre of the second car (bench/trace/car) and N seeds (1001 .. 1000 + N, the clean
+// runs of dynid-bench-trace's false-alarm count): a clean run with the car's normal sensor noise
+// through the product's data path, every model of the manoeuvre fitted as benchcar.toml declares
+// it, and per parameter with a known truth the error against the estimate table's std (DYCARO's
+// weighted LS) and the HAC std of `dynid consistency`. Prints one line per seed, the markdown
+// table, a verdict per parameter against issue 16's goals and the run time; --json writes every
+// seed. Measurement only: no estimator is tuned here. `--smoke` is the ctest check of the harness.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "car/product_path.hpp"
+#include "goals.hpp"
+#include "json_out.hpp"
+#include "measure.hpp"
+#include "options.hpp"
+#include "smoke.hpp"
+#include "summary.hpp"
+
+namespace {
+
+using namespace dynid;
+using namespace dynid::benchcoverage;
+
+void print_seed(const SeedRun& r) {
+  std::printf("%-12s seed %llu (%.1f s)", benchcar::manoeuvre_name(r.manoeuvre), static_cast<unsigned long long>(r.seed),
+              r.seconds);
+  if (!r.error.empty()) std::printf(" ERROR: %s", r.error.c_str());
+  const std::string* model = nullptr;  // named once before its parameters: two models share names
+  for (const ParameterSample& s : r.samples) {
+    if (model == nullptr || *model != s.model) std::printf("; %s:", s.model.c_str());
+    model = &s.model;
+    std::printf(" %s %+.2f %% (std %.2f, HAC %.2f)", s.parameter.c_str(), 100.0 * s.relative_error(),
+                100.0 * s.std / std::abs(s.truth), 100.0 * s.hac_std / std::abs(s.truth));
+  }
+  std::printf("\n");
+  std::fflush(stdout);
+}
+
+std::vector<SeedRun> measure_all(const Options& o, const car::VehicleProfile& profile,
+                                 const std::filesystem::path& work_dir) {
+  std::vector<SeedRun> runs;
+  for (benchcar::Manoeuvre m : o.manoeuvres)
+    for (int s = 1; s <= o.seeds; ++s) {
+      runs.push_back(measure_seed(profile, m, 1000 + static_cast<std::uint64_t>(s), o.noise_scale, work_dir));
+      print_seed(runs.back());
+    }
+  return runs;
+}
+
+int errors_of(const std::vector<SeedRun>& runs) {
+  int n = 0;
+  for (const SeedRun& r : runs) n += r.error.empty() ? 0 : 1;
+  return n;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options o = parse_options(argc, argv);
+  const car::VehicleProfile& profile = benchcar::profile(o.profile);
+  const std::filesystem::path work_dir =
+      std::filesystem::temp_directory_path() / ("dynid-bench-coverage-" + std::to_string(::getpid()));
+  if (o.smoke) {
+    const int failures = run_smoke(profile, work_dir);
+    std::filesystem::remove_all(work_dir);
+    return failures == 0 ? 0 : 1;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::printf("dynid-bench-coverage: %d clean runs per manoeuvre (seeds 1001-%d), the car's sensor noise x %g\n",
+              o.seeds, 1000 + o.seeds, o.noise_scale);
+  const std::vector<SeedRun> runs = measure_all(o, profile, work_dir);
+  std::filesystem::remove_all(work_dir);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::vector<ParameterCoverage> rows = summarize(runs);
+  std::printf("\n%s\n%s\n%zu runs, %d failed, %.0f s\n", markdown_table(rows).c_str(), verdicts(rows).c_str(), runs.size(),
+              errors_of(runs), seconds);
+  if (!o.json.empty() && !write_json(o.json, runs, rows, seconds)) return 1;
+  return errors_of(runs) == 0 ? 0 : 1;
+}

@@ -1,0 +1,72 @@
+#include "measure.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <exception>
+
+#include "car/clean_run.hpp"
+#include "car/declared_fit.hpp"
+
+namespace dynid::benchcoverage {
+namespace {
+
+// Each parameter of one model that has a truth on this run, with both std. The parameter order
+// of the two fits is the model's (one fold of the same rows), checked by name all the same.
+void add_model(const car::VehicleProfile& profile, const std::string& model, const benchcar::CleanRun& run,
+               std::vector<ParameterSample>& out) {
+  const residual::ModelFit fit = benchcar::declared_fit(profile, model, run.product.recorded, run.segments);
+  const residual::ModelParameters hac = benchcar::declared_hac(profile, model, run.product.recorded, run.segments);
+  for (std::size_t i = 0; i < fit.parameters.size(); ++i) {
+    const std::string& name = fit.parameters[i].name;
+    const auto truth = run.truth.parameters.find(name);
+    if (truth == run.truth.parameters.end()) continue;
+    ParameterSample s;
+    s.model = model;
+    s.parameter = name;
+    s.truth = truth->second;
+    const auto k = static_cast<Eigen::Index>(i);
+    s.value = fit.estimate.value(k);
+    s.std = fit.estimate.standard_deviation(k);
+    if (i < hac.parameters.size() && hac.parameters[i].name == name) {
+      s.hac_value = hac.value(k);
+      s.hac_std = hac.std(k);
+    }
+    out.push_back(s);
+  }
+}
+
+}  // namespace
+
+double ParameterSample::relative_error() const { return (value - truth) / std::abs(truth); }
+
+const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre) {
+  static const std::vector<std::string> longitudinal = {"longitudinal_wheel", "longitudinal_engine"};
+  static const std::vector<std::string> lateral = {"lateral_bicycle"};
+  static const std::vector<std::string> launch = {"clutch_slip"};
+  static const std::vector<std::string> none;
+  switch (manoeuvre) {
+    case benchcar::Manoeuvre::kLongitudinal: return longitudinal;
+    case benchcar::Manoeuvre::kLateral: return lateral;
+    case benchcar::Manoeuvre::kLaunch: return launch;
+    case benchcar::Manoeuvre::kCruise: return none;
+  }
+  return none;
+}
+
+SeedRun measure_seed(const car::VehicleProfile& profile, benchcar::Manoeuvre manoeuvre, std::uint64_t seed,
+                     double noise_scale, const std::filesystem::path& work_dir) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SeedRun r;
+  r.manoeuvre = manoeuvre;
+  r.seed = seed;
+  try {
+    const benchcar::CleanRun run = benchcar::clean_run(profile, manoeuvre, seed, noise_scale, work_dir);
+    for (const std::string& model : models_of(manoeuvre)) add_model(profile, model, run, r.samples);
+  } catch (const std::exception& e) {
+    r.error = e.what();
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+}  // namespace dynid::benchcoverage

@@ -1,0 +1,50 @@
+#pragma once
+// One seed of the coverage benchmark: a clean run of one manoeuvre (car/clean_run.hpp: the car's
+// normal sensor noise, no effect injected), every model identified on that manoeuvre fitted as
+// the profile declares it, and for each parameter with a known truth its value with the two
+// standard deviations the product reports (car/declared_fit.hpp): the estimate table's (DYCARO's
+// weighted LS) and the HAC one of `dynid consistency`.
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <dynid/car/vehicle_profile.hpp>
+
+#include "car/manoeuvres.hpp"
+
+namespace dynid::benchcoverage {
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct ParameterSample {
+  std::string model;
+  std::string parameter;
+  double truth = kNaN;
+  double value = kNaN;      ///< the estimate table's value (NaN: not identifiable)
+  double std = kNaN;        ///< its std, sigma^2 (W'W)^-1
+  double hac_value = kNaN;  ///< residual::hac_parameters' value (the same estimator)
+  double hac_std = kNaN;
+  /// (value - truth) / |truth|: relative, so that a negative truth (the clutch's viscous slope)
+  /// keeps the error's sign.
+  double relative_error() const;
+};
+
+struct SeedRun {
+  benchcar::Manoeuvre manoeuvre = benchcar::Manoeuvre::kLongitudinal;
+  std::uint64_t seed = 0;
+  double seconds = 0.0;
+  std::string error;  ///< non-empty: the run or a fit failed (InputError text)
+  std::vector<ParameterSample> samples;
+};
+
+/// The models identified on a manoeuvre (docs/RESIDUAL.md "Benchmark on a second car").
+const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre);
+
+/// One clean run at `seed` (sensor noise times noise_scale) and its fits. Never throws: a failure
+/// is SeedRun::error.
+SeedRun measure_seed(const car::VehicleProfile& profile, benchcar::Manoeuvre manoeuvre, std::uint64_t seed,
+                     double noise_scale, const std::filesystem::path& work_dir);
+
+}  // namespace dynid::benchcoverage

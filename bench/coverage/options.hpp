@@ -1,0 +1,23 @@
+#pragma once
+// The coverage benchmark's command line (dynid-bench-coverage --help).
+#include <string>
+#include <vector>
+
+#include "car/manoeuvres.hpp"
+
+namespace dynid::benchcoverage {
+
+struct Options {
+  int seeds = 20;  ///< clean runs per manoeuvre, seeds 1001 .. 1000 + seeds
+  std::vector<benchcar::Manoeuvre> manoeuvres = {benchcar::Manoeuvre::kLongitudinal, benchcar::Manoeuvre::kLateral,
+                                                 benchcar::Manoeuvre::kLaunch};
+  double noise_scale = 1.0;  ///< the car's sensor noise times this (0: noise-free, to tell noise from model error)
+  std::string json;  ///< per-seed values, empty: none
+  std::string profile = DYNID_BENCHCAR_PROFILE;
+  bool smoke = false;
+};
+
+/// Exits with status 2 and the usage on a bad argument.
+Options parse_options(int argc, char** argv);
+
+}  // namespace dynid::benchcoverage

@@ -1,0 +1,99 @@
+#include "summary.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace dynid::benchcoverage {
+namespace {
+
+bool usable(const ParameterSample& s) {
+  return std::isfinite(s.value) && std::isfinite(s.std) && std::isfinite(s.hac_std);
+}
+
+double mean(const std::vector<double>& x) {
+  double sum = 0.0;
+  for (double v : x) sum += v;
+  return x.empty() ? kNaN : sum / static_cast<double>(x.size());
+}
+
+double scatter(const std::vector<double>& x) {
+  if (x.size() < 2) return kNaN;
+  const double m = mean(x);
+  double sum = 0.0;
+  for (double v : x) sum += (v - m) * (v - m);
+  return std::sqrt(sum / static_cast<double>(x.size() - 1));
+}
+
+// errors and std in % of the truth, seed by seed.
+StdCoverage coverage_of(const std::vector<double>& errors, const std::vector<double>& stds) {
+  StdCoverage c;
+  c.mean_std_pct = mean(stds);
+  int within = 0;
+  for (std::size_t i = 0; i < errors.size(); ++i) within += std::abs(errors[i]) <= 2.0 * stds[i] ? 1 : 0;
+  c.within_2std = errors.empty() ? kNaN : static_cast<double>(within) / static_cast<double>(errors.size());
+  c.error_over_std = std::abs(mean(errors)) / c.mean_std_pct;
+  return c;
+}
+
+ParameterCoverage row_of(const std::vector<const ParameterSample*>& samples) {
+  ParameterCoverage row;
+  row.model = samples.front()->model;
+  row.parameter = samples.front()->parameter;
+  row.truth = samples.front()->truth;
+  std::vector<double> errors, table, hac;
+  for (const ParameterSample* s : samples) {
+    if (!usable(*s)) continue;
+    errors.push_back(100.0 * s->relative_error());
+    table.push_back(100.0 * s->std / std::abs(s->truth));
+    hac.push_back(100.0 * s->hac_std / std::abs(s->truth));
+  }
+  row.seeds = static_cast<int>(errors.size());
+  row.errors_pct = errors;
+  row.mean_error_pct = mean(errors);
+  row.scatter_pct = scatter(errors);
+  row.table = coverage_of(errors, table);
+  row.hac = coverage_of(errors, hac);
+  return row;
+}
+
+std::string cells(const StdCoverage& c) {
+  char b[120];
+  std::snprintf(b, sizeof b, " %.3g %% | %.0f %% | %.2f |", c.mean_std_pct, 100.0 * c.within_2std, c.error_over_std);
+  return b;
+}
+
+}  // namespace
+
+std::vector<ParameterCoverage> summarize(const std::vector<SeedRun>& runs) {
+  std::vector<std::pair<std::string, std::string>> keys;
+  for (const SeedRun& r : runs)
+    for (const ParameterSample& s : r.samples)
+      if (std::find(keys.begin(), keys.end(), std::make_pair(s.model, s.parameter)) == keys.end())
+        keys.emplace_back(s.model, s.parameter);
+  std::vector<ParameterCoverage> rows;
+  for (const auto& [model, parameter] : keys) {
+    std::vector<const ParameterSample*> samples;
+    for (const SeedRun& r : runs)
+      for (const ParameterSample& s : r.samples)
+        if (s.model == model && s.parameter == parameter) samples.push_back(&s);
+    rows.push_back(row_of(samples));
+  }
+  return rows;
+}
+
+std::string markdown_table(const std::vector<ParameterCoverage>& rows) {
+  std::string out =
+      "| model | parameter | truth | seeds | mean error | scatter | table std | within 2 table std | mean error / "
+      "table std | HAC std | within 2 HAC std | mean error / HAC std |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const ParameterCoverage& r : rows) {
+    char b[200];
+    std::snprintf(b, sizeof b, "| %s | %s | %.6g | %d | %+.3g %% | %.3g %% |", r.model.c_str(), r.parameter.c_str(),
+                  r.truth, r.seeds, r.mean_error_pct, r.scatter_pct);
+    out += b + cells(r.table) + cells(r.hac) + "\n";
+  }
+  return out;
+}
+
+}  // namespace dynid::benchcoverage
