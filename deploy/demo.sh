@@ -12,7 +12,8 @@
 #   3. dynid-server with a temporary store
 #   4. dynid-car --replay can.log --fast with deploy/profiles/testcar.toml: decode, resample,
 #      chunk, spool, publish; it exits once the server has acknowledged every chunk durably
-#   5. dynid close (the run is over: final estimates), dynid estimates, a reprocess of the
+#   5. dynid close (the run is over: final estimates), dynid estimates, dynid excitation (what the
+#      run identifies, and the manoeuvres that would bring the rest), a reprocess of the
 #      lateral model with the effects the accuracy work found, and the truth after them
 #   6. the server is stopped with SIGTERM and exits cleanly
 #
@@ -81,6 +82,9 @@ step "dynid-car: replaying can.log as run $run_id"
 step "closing the run and asking for the estimates (dynid estimates --vehicle $vehicle)"
 "$cli" --cyclone-config "$config" close --vehicle "$vehicle" --run "$run_id" > /dev/null
 "$cli" --cyclone-config "$config" estimates --vehicle "$vehicle"
+
+step "what this run identifies, and the manoeuvres for the rest (dynid excitation --vehicle $vehicle)"
+"$cli" --cyclone-config "$config" excitation --vehicle "$vehicle"
 
 # The profile runs the lateral model bare. The effects the accuracy test found (tyre
 # saturation, sensor offsets in the slip angles, roll acceleration; docs/ACCURACY.md) take its

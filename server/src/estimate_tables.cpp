@@ -1,5 +1,7 @@
 #include "dynid/server/estimate_tables.hpp"
 
+#include <algorithm>
+
 #include "dynid/report/estimate_report.hpp"
 #include "dynid/report/json.hpp"
 
@@ -32,6 +34,21 @@ EstimateTables tables_of(const std::string& vehicle, const std::string& source,
       out.tables.push_back(table_of(vehicle, source, e.model, e.parameters, *e.estimate));
     else
       out.notes.push_back(e.model + ": " + (e.note.empty() ? "no estimate yet" : e.note));
+  }
+  return out;
+}
+
+report::ExcitationReport excitation_of(const std::string& vehicle, const std::string& run,
+                                       const std::vector<ingest::ModelEstimate>& estimates) {
+  report::ExcitationReport out{vehicle, run, {}, {}};
+  const EstimateTables tables = tables_of(vehicle, run, estimates);
+  out.notes = tables.notes;
+  for (const dds::EstimateTable& table : tables.tables) {
+    const auto e = std::find_if(estimates.begin(), estimates.end(),
+                                [&](const ingest::ModelEstimate& m) { return m.model == table.model; });
+    report::ModelExcitation m{table, {}};
+    for (const auto& p : e->parameters) m.excited_by.push_back(p.excited_by);
+    out.models.push_back(std::move(m));
   }
   return out;
 }

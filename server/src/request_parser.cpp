@@ -22,6 +22,7 @@ const std::map<std::string, KindSpec>& kinds() {
       {"vehicles", {{}, {"format"}, {}}},
       {"runs", {{"vehicle"}, {"format"}, {}}},
       {"estimate", {{"vehicle"}, {"run", "model", "format"}, {}}},
+      {"excitation", {{"vehicle"}, {"run", "format"}, {}}},
       {"pooled", {{"vehicle", "run"}, {"model", "format"}, {"run"}}},
       {"close", {{"vehicle", "run"}, {"format"}, {}}},
       {"reprocess", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},

@@ -96,6 +96,15 @@ EstimateTables RunService::estimate(const std::string& vehicle,
   return tables;
 }
 
+report::ExcitationReport RunService::excitation(const std::string& vehicle, const std::optional<std::string>& run) {
+  settle();  // the chunks received before this request count, the ledger up to date
+  const store::RunKey key{vehicle, run ? *run : latest_run(vehicle)};
+  const RunState& state = load(key);
+  report::ExcitationReport out = excitation_of(vehicle, key.run, state.processor.estimates());
+  if (!state.halted.empty()) out.notes.push_back(key.run + ": " + state.halted);
+  return out;
+}
+
 EstimateTables RunService::pooled(const std::string& vehicle, const std::vector<std::string>& runs,
                                   const std::optional<std::string>& model) {
   settle();  // the chunks received before this request count, the ledger up to date

@@ -9,6 +9,7 @@
 #include "dynid/dds/conversions.hpp"
 #include "dynid/dds/topics.hpp"
 #include "dynid/error.hpp"
+#include "dynid/report/excitation_report.hpp"
 #include "dynid/report/json.hpp"
 #include "server_impl.hpp"
 
@@ -153,6 +154,9 @@ dds::Reply Server::Impl::execute(const ParsedRequest& r, RunService& service) {
     payload = service.list_runs(vehicle, r.json());
   } else if (r.kind == "estimate") {
     payload = render(service.estimate(vehicle, r.optional("run"), r.optional("model")), r.json());
+  } else if (r.kind == "excitation") {
+    const report::ExcitationReport report = service.excitation(vehicle, r.optional("run"));
+    payload = r.json() ? report::excitation_json(report) : report::format_excitation_text(report);
   } else if (r.kind == "pooled") {
     payload = render(service.pooled(vehicle, r.all("run"), r.optional("model")), r.json());
   } else if (r.kind == "close") {

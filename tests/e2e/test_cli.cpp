@@ -48,6 +48,24 @@ TEST(E2eCli, EstimatesTableAgainstRunningServer) {
   ASSERT_EQ(json.exit_code, 0) << json.err;
   EXPECT_EQ(json.out.rfind("{\"tables\":[{\"vehicle\":\"cli-car\",\"model\":\"locked_driveline\"", 0), 0u) << json.out;
 
+  // Issue 16 item 4: the excitation report of the same run says, per model, what the tables say.
+  const auto excitation = dynid({"excitation", "--vehicle", "cli-car"});
+  ASSERT_EQ(excitation.exit_code, 0) << excitation.err;
+  EXPECT_NE(excitation.out.find("cli-car / run run-c: what this run identifies"), std::string::npos) << excitation.out;
+  EXPECT_NE(excitation.out.find("  longitudinal_wheel: identifies "), std::string::npos) << excitation.out;
+  const auto excitation_json = dynid({"--json", "excitation", "--vehicle", "cli-car", "--run", "run-c"});
+  ASSERT_EQ(excitation_json.exit_code, 0) << excitation_json.err;
+  const auto all = dynid({"--json", "estimates", "--vehicle", "cli-car", "--run", "run-c"});
+  const auto report = nlohmann::json::parse(excitation_json.out);
+  const auto tables = nlohmann::json::parse(all.out)["tables"];
+  ASSERT_EQ(report["models"].size(), tables.size()) << excitation_json.out;
+  for (std::size_t m = 0; m < tables.size(); ++m) {
+    ASSERT_EQ(report["models"][m]["model"], tables[m]["model"]);
+    ASSERT_EQ(report["models"][m]["parameters"].size(), tables[m]["parameters"].size());
+    for (std::size_t j = 0; j < tables[m]["parameters"].size(); ++j)
+      EXPECT_EQ(report["models"][m]["parameters"][j]["status"], tables[m]["parameters"][j]["status"]);
+  }
+
   const auto vehicles = dynid({"vehicles"});
   EXPECT_EQ(vehicles.out, "cli-car\n") << vehicles.err;
   const auto runs = dynid({"runs", "--vehicle", "cli-car"});

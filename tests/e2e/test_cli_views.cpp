@@ -1,6 +1,7 @@
-// What the dynid CLI prints for people and tools, without DDS (issue 16, items 1 and 6): the compact
+// What the dynid CLI prints for people and tools, without DDS (issue 16, items 1, 4 and 6): the compact
 // view of `dynid watch --model` (how a value moved, the in-place redraw, JSON lines) and
-// `dynid status` as text, and the estimate table of a model the run does not excite.
+// `dynid status` as text, the estimate table of a model the run does not excite, and the
+// excitation report (what a run identifies, and the manoeuvres that would bring the rest).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 #include "dynid/cli/shard_replies.hpp"
 #include "dynid/cli/watch_view.hpp"
 #include "dynid/report/estimate_report.hpp"
+#include "dynid/report/excitation_report.hpp"
 
 namespace dynid::test {
 namespace {
@@ -121,6 +123,52 @@ TEST(StatusText, OneCounterPerLineWithWhatItCounts) {
   const std::string partial = cli::status_text(two);
   EXPECT_NE(partial.find("shard 1/2\n  chunks stored durably"), std::string::npos) << partial;
   EXPECT_NE(partial.find("shard 0/2: did not answer"), std::string::npos) << partial;
+}
+
+// Issue 16 item 4: per model what the run identifies and what it cannot with the signal to move;
+// then each manoeuvre once, with every parameter of every model it would bring.
+TEST(ExcitationReport, GroupsWhatTheRunCannotIdentifyByTheManoeuvreThatWould) {
+  report::ExcitationReport r{"car", "sine-steer", {}, {"clutch_slip: not run: no clutch_clamp_load"}};
+  auto wheel = table(1, 160.0, 24.0);  // mass 15 % (poorly identified), SCx not excited
+  wheel.parameters[0].status = ls::ParameterStatus::kPoorlyIdentified;
+  wheel.parameters[0].relative_std_percent = 15.0;
+  auto engine = wheel;
+  engine.model = "longitudinal_engine";
+  engine.parameters[1].status = ls::ParameterStatus::kImplausible;
+  engine.parameters[1].reason = "-6.7 m^2 outside (0, 2]";
+  const std::string accelerate = "d_vx (accelerate, brake)", coast = "vx over a wide range (coast down from high speed)";
+  r.models = {{wheel, {accelerate, coast}}, {engine, {accelerate, coast}}};
+
+  const auto needs = report::manoeuvre_needs(r);
+  ASSERT_EQ(needs.size(), 2u);
+  EXPECT_EQ(needs[0].excited_by, accelerate);
+  EXPECT_EQ(needs[0].poorly_identified, (std::vector<std::string>{"longitudinal_wheel.mass", "longitudinal_engine.mass"}));
+  EXPECT_EQ(needs[1].excited_by, coast);
+  // An implausible value is a model error, not a manoeuvre's: not listed under one.
+  EXPECT_EQ(needs[1].not_excited, (std::vector<std::string>{"longitudinal_wheel.SCx"}));
+
+  const std::string text = report::format_excitation_text(r);
+  EXPECT_NE(text.find("car / run sine-steer: what this run identifies\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("  longitudinal_wheel: identifies 0 of 2\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("    not excited: SCx (needs " + coast + ")\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("    poorly identified: mass (15 %; needs more " + accelerate + ")\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("implausible, a model error or a missing effect rather than the manoeuvre (dynid residual): SCx"),
+            std::string::npos) << text;
+  EXPECT_NE(text.find("  clutch_slip: not run: no clutch_clamp_load\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("  " + coast + ": longitudinal_wheel.SCx\n"), std::string::npos) << text;
+
+  const auto json = nlohmann::json::parse(report::excitation_json(r));
+  EXPECT_EQ(json["models"][1]["parameters"][1]["status"], "implausible");
+  EXPECT_EQ(json["models"][0]["parameters"][1]["excited_by"], coast);
+  EXPECT_EQ(json["manoeuvres"][0]["poorly_identified"].size(), 2u);
+}
+
+TEST(ExcitationReport, SaysSoWhenEveryParameterIsIdentified) {
+  report::ExcitationReport r{"car", "r", {{table(1, 1500.0, 3.0), {"d_vx (accelerate, brake)", ""}}}, {}};
+  r.models[0].table.parameters[1].status = ls::ParameterStatus::kIdentified;
+  const std::string text = report::format_excitation_text(r);
+  EXPECT_NE(text.find("identifies 2 of 2: mass, SCx"), std::string::npos) << text;
+  EXPECT_NE(text.find("Every parameter this run can excite is identified."), std::string::npos) << text;
 }
 
 }  // namespace

@@ -197,6 +197,10 @@ int main(int argc, char** argv) {
   estimates_cmd->add_option("--vehicle", vehicle)->required();
   estimates_cmd->add_option("--run", run);
   estimates_cmd->add_option("--model", model);
+  auto* excitation_cmd = app.add_subcommand(
+      "excitation", "what a run (latest by default) identifies, and the manoeuvres that would identify the rest");
+  excitation_cmd->add_option("--vehicle", vehicle)->required();
+  excitation_cmd->add_option("--run", run);
   auto* watch_cmd = app.add_subcommand(
       "watch", "print estimates as they are published (--model: one model, compact, updated in place)");
   watch_cmd->add_option("--vehicle", vehicle)->required();
@@ -288,6 +292,7 @@ int main(int argc, char** argv) {
     if (*runs_cmd) return request(c, "runs", args({{"vehicle", vehicle}}));
     if (*estimates_cmd)
       return request(c, "estimate", args({{"vehicle", vehicle}, {"run", run}, {"model", model}}));
+    if (*excitation_cmd) return request(c, "excitation", args({{"vehicle", vehicle}, {"run", run}}));
     if (*watch_cmd) return watch(c, vehicle, model, seconds);
     if (*pooled_cmd) {
       auto a = args({{"vehicle", vehicle}, {"model", model}});

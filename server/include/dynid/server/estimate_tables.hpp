@@ -10,6 +10,7 @@
 
 #include "dynid/dds/estimate_table.hpp"
 #include "dynid/ingest/run_processor.hpp"
+#include "dynid/report/excitation_report.hpp"
 
 namespace dynid::server {
 
@@ -26,6 +27,11 @@ dds::EstimateTable table_of(const std::string& vehicle, const std::string& sourc
 EstimateTables tables_of(const std::string& vehicle, const std::string& source,
                          const std::vector<ingest::ModelEstimate>& estimates,
                          const std::optional<std::string>& model = std::nullopt);
+
+/// The run's excitation report (report/excitation_report.hpp): its tables as tables_of() makes
+/// them, each parameter with the signal that excites it (model::ParameterInfo::excited_by).
+report::ExcitationReport excitation_of(const std::string& vehicle, const std::string& run,
+                                       const std::vector<ingest::ModelEstimate>& estimates);
 
 /// Text (the tables, then the notes) or JSON ({"tables":[...],"notes":[...]}).
 std::string render(const EstimateTables& tables, bool json);

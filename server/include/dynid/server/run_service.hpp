@@ -124,6 +124,9 @@ class RunService {
   // Run-level requests. InputError/NotFound name what is wrong.
   EstimateTables estimate(const std::string& vehicle, const std::optional<std::string>& run,
                           const std::optional<std::string>& model);
+  /// What the run (latest by default) identifies and which manoeuvres would bring the rest
+  /// (report/excitation_report.hpp).
+  report::ExcitationReport excitation(const std::string& vehicle, const std::optional<std::string>& run);
   /// Also published on the Estimate topic (source "pool:<run>+<run>...").
   EstimateTables pooled(const std::string& vehicle, const std::vector<std::string>& runs,
                         const std::optional<std::string>& model);
