@@ -84,10 +84,28 @@ TEST(Effects, DictionaryColumnsByHand) {
   EXPECT_DOUBLE_EQ(g.W(r3, 5), 225.0);
 }
 
+// An interaction of two channels (issue 15): dict:prod:<a>*<b> is a b, read from both channels,
+// named once per pair; a malformed product is not a dictionary name.
+TEST(Effects, ProductOfTwoChannels) {
+  const auto m = model::make_model("longitudinal_wheel", kLon);
+  const model::ChannelSet set = small_set();
+  const auto g = m->rows(set, {"dict:prod:vx*ax"}).front();
+  const auto r = static_cast<Eigen::Index>(row_of(g, 4));
+  EXPECT_DOUBLE_EQ(g.W(r, 3), 17.0 * 5.5);
+  const model::Effect e = model::dictionary_effect("dict:prod:vx*ax", {"model"});
+  EXPECT_EQ(e.channels, (std::vector<std::string>{"vx", "ax"}));
+  const auto all = model::dictionary_effects(set);
+  // Each pair once, in the set's order of names (alphabetical: ax before vx).
+  EXPECT_EQ(std::count_if(all.begin(), all.end(), [](const model::Effect& x) { return x.name == "dict:prod:ax*vx"; }), 1);
+  EXPECT_EQ(std::count_if(all.begin(), all.end(), [](const model::Effect& x) { return x.name == "dict:prod:vx*ax"; }), 0);
+  for (const char* bad : {"dict:prod:vx", "dict:prod:*ax", "dict:prod:vx*", "dict:prod:vx*ax*ax"})
+    EXPECT_FALSE(model::is_dictionary_effect(bad)) << bad;
+}
+
 TEST(Effects, DictionaryListsEveryChannelAndExpandsPerGroup) {
   const model::ChannelSet set = small_set();
   const auto all = model::dictionary_effects(set);
-  EXPECT_EQ(all.size(), 6u * 8u);
+  EXPECT_EQ(all.size(), 6u * 8u + 6u * 5u / 2u);  // 8 ops per channel, a product per pair
   EXPECT_TRUE(std::any_of(all.begin(), all.end(),
                           [](const model::Effect& e) { return e.name == "dict:sq:vx"; }));
   EXPECT_TRUE(model::is_dictionary_effect("dict:lag3:ax"));

@@ -9,6 +9,7 @@
 #include <boost/math/distributions/normal.hpp>
 
 #include "dynid/error.hpp"
+#include "dynid/model/effects.hpp"
 
 namespace dynid::residual {
 namespace {
@@ -215,9 +216,9 @@ double lowest_ratio(const GroupFloor& g, std::size_t groups) {
 std::vector<std::string> sensors_of(const CandidateScore& c, const std::vector<model::Effect>& effects) {
   for (const model::Effect& e : effects)
     if (e.name == c.effect) return e.channels;
-  for (const char* prefix : {"dict:", "delay:"}) {
-    if (c.effect.rfind(prefix, 0) != 0) continue;
-    std::string channel = c.effect.substr(c.effect.rfind(':') + 1);
+  if (model::is_dictionary_effect(c.effect)) return model::dictionary_effect(c.effect, {"model"}).channels;
+  if (c.effect.rfind("delay:", 0) == 0) {  // delay:<channel>@<ms>
+    const std::string channel = c.effect.substr(c.effect.rfind(':') + 1);
     return {channel.substr(0, channel.find('@'))};
   }
   return {};

@@ -8,6 +8,9 @@
 //     dict:x:<x>     x                  dict:sgn:<x>   sgn x
 //     dict:sq:<x>    x^2                dict:d:<x>     dx/dt (central difference)
 //     dict:absx:<x>  |x| x              dict:lag<L>:<x> x delayed by L = 1, 2, 3 samples
+//     dict:prod:<a>*<b>  a b: an interaction of two channels (every pair of the set, a before b
+//                        in the set's order), e.g. a torque error that grows with engine speed
+//                        times the gear, a stiffness that changes with the lateral acceleration
 // Every model accepts these names. A dictionary effect adds one parameter per equation group
 // (an unknown effect enters each equation with its own coefficient): named `<effect>` when the
 // model has one group, `<effect>@<group>` otherwise; its column is zero in the other groups.
