@@ -114,6 +114,35 @@ ingest::RecordedRun kinematic_run(std::uint64_t seed, double grade_amplitude, do
   return recorded({{"vx", vx}, {"ax", ax}});
 }
 
+// The noise floor's draws change one channel of the run: preprocessing that channel again (and
+// the derivative made from it) is exactly preprocessing the whole run, on runs with a gap (two
+// segments) and with an announced channel named like a derivative (kept as announced).
+TEST(NoiseFloor, PreprocessingOneChannelAgainEqualsPreprocessingTheRun) {
+  auto run = kinematic_run(21, 0.02);
+  run.announcement.channels.push_back({"d_ax", "m/s^3"});
+  Eigen::MatrixXd samples(run.samples.rows(), 3);
+  samples << run.samples, Eigen::VectorXd::LinSpaced(run.samples.rows(), 0.0, 1.0);
+  run.samples = samples;
+  for (Eigen::Index k = 2500; k < 2600; ++k) run.valid[static_cast<std::size_t>(k)] = 0;
+  const auto base = ingest::preprocess_offline(run);
+  ASSERT_EQ(base.size(), 2u);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n01;
+  for (Eigen::Index column = 0; column < 3; ++column) {
+    auto changed = run;
+    for (Eigen::Index k = 0; k < changed.samples.rows(); ++k) changed.samples(k, column) += 0.1 * n01(rng);
+    const auto expected = ingest::preprocess_offline(changed);
+    const auto again = ingest::preprocess_channel_again(changed, base, column);
+    ASSERT_EQ(again.size(), expected.size());
+    for (std::size_t s = 0; s < again.size(); ++s) {
+      EXPECT_EQ(again[s].first, expected[s].first);
+      ASSERT_EQ(again[s].channels.names(), expected[s].channels.names());
+      for (const std::string& name : expected[s].channels.names())
+        EXPECT_TRUE(again[s].channels[name] == expected[s].channels[name]) << "column " << column << ", " << name;
+    }
+  }
+}
+
 TEST(NoiseFloor, AModelThatLacksNothingIsAdequateAtTheStatedRate) {
   const auto model = model::make_model("kinematic_longitudinal", {});
   int adequate = 0;

@@ -97,4 +97,24 @@ std::vector<PreprocessedSegment> preprocess_offline(const RecordedRun& run) {
   return out;
 }
 
+std::vector<PreprocessedSegment> preprocess_channel_again(const RecordedRun& run,
+                                                          std::vector<PreprocessedSegment> segments,
+                                                          Eigen::Index column) {
+  const ChannelSpec& changed = run.announcement.channels.at(static_cast<std::size_t>(column));
+  RecordedRun one{run.announcement, run.first_sample_index, run.samples.col(column), run.valid};
+  one.announcement.channels = {changed};
+  const std::vector<PreprocessedSegment> again = preprocess_offline(one);
+  if (again.size() != segments.size()) return preprocess_offline(run);  // not the same validity
+  // The derivative made from the channel, unless the run announces a channel of that name (which
+  // preprocessing keeps as it is).
+  const std::string derivative = "d_" + changed.name;
+  const bool derived = std::none_of(run.announcement.channels.begin(), run.announcement.channels.end(),
+                                    [&](const ChannelSpec& c) { return c.name == derivative; });
+  for (std::size_t s = 0; s < segments.size(); ++s) {
+    segments[s].channels.replace(changed.name, again[s].channels[changed.name]);
+    if (derived) segments[s].channels.replace(derivative, again[s].channels[derivative]);
+  }
+  return segments;
+}
+
 }  // namespace dynid::ingest

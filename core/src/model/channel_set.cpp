@@ -32,6 +32,19 @@ void ChannelSet::add(const std::string& name, const std::string& unit, Eigen::Ve
   channels_.emplace(name, Channel{unit, std::move(values)});
 }
 
+void ChannelSet::replace(const std::string& name, Eigen::VectorXd values) {
+  const auto it = channels_.find(name);
+  if (it == channels_.end()) throw InputError("channel set: no channel '" + name + "' to replace");
+  Channel old = std::move(it->second);
+  channels_.erase(it);
+  try {
+    add(name, old.unit, std::move(values));  // the same checks as a new channel
+  } catch (...) {
+    channels_.emplace(name, std::move(old));  // the set unchanged
+    throw;
+  }
+}
+
 const Eigen::VectorXd& ChannelSet::operator[](const std::string& name) const {
   const auto it = channels_.find(name);
   if (it == channels_.end()) throw InputError("channel set: no channel '" + name + "'");

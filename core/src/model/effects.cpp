@@ -53,7 +53,7 @@ Parsed parse(const std::string& name) {
   for (const Op& op : kOps) {
     if (token != op.token) continue;
     if (token == kProduct) return parse_product(&op, name.substr(colon + 1));
-    return {&op, name.substr(colon + 1)};
+    return {&op, name.substr(colon + 1), {}};
   }
   return {};
 }

@@ -271,7 +271,7 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
     if (column < 0 || !(c.sigma > 0.0)) continue;
     std::vector<LagSums> sums(r0.size());
     for (int d = 0; d < options.draws; ++d) {
-      const auto noisy = ingest::preprocess_offline(with_noise(run, column, c.sigma, rng));
+      const auto noisy = ingest::preprocess_channel_again(with_noise(run, column, c.sigma, rng), segments, column);
       const detail::GridResiduals r1 =
           detail::residuals_at(detail::fold_rows(model, effects, noisy, rate, odmf, fit_options, true, &rows), x);
       for (std::size_t g = 0; g < sums.size(); ++g) sums[g].add(difference(r1[g], r0[g]), odmf);

@@ -26,6 +26,8 @@ class ChannelSet {
   /// Adds a channel (SI unit given for documentation and checks).
   void add(const std::string& name, const std::string& unit, Eigen::VectorXd values);
   bool has(const std::string& name) const { return channels_.count(name) > 0; }
+  /// Replaces the values of a channel the set has (same checks as add, InputError when absent).
+  void replace(const std::string& name, Eigen::VectorXd values);
   /// The values of a channel; throws InputError naming the missing channel.
   const Eigen::VectorXd& operator[](const std::string& name) const;
   const std::string& unit(const std::string& name) const;
