@@ -68,7 +68,10 @@ step "starting dynid-server (store $work/store.db, log $work/server.log)"
 # OPENBLAS_NUM_THREADS=1: OpenBLAS starts its thread pool when the library loads, before
 # dynid-server blocks SIGTERM for its sigwait thread; such a thread would take the SIGTERM and
 # kill the server instead of stopping it cleanly. The server folds on its own workers anyway.
-OPENBLAS_NUM_THREADS=1 "$server" --store "$work/store.db" --cyclone-config "$config" > "$work/server.log" 2>&1 &
+# --live-residual 2: the residual loop's verdict of each model, kept current as the run streams (at
+# most every 2 s of its growth, and at its close) and published beside the estimates.
+OPENBLAS_NUM_THREADS=1 "$server" --store "$work/store.db" --cyclone-config "$config" --live-residual 2 \
+  > "$work/server.log" 2>&1 &
 server_pid=$!
 
 step "dynid-car: replaying can.log as run $run_id"
@@ -123,6 +126,20 @@ hill_run="hill-$(date -u +%Y%m%dT%H%M%SZ)"
   exit 1
 }
 "$cli" --cyclone-config "$config" close --vehicle "$vehicle" --run "$hill_run" > /dev/null
+# The live verdict of the closed run (its last chunk included) comes with a publication after the
+# close: the diagnosis runs beside the folding, not in the request.
+last_chunk=$(( $(sed -n 's/.*all chunks acknowledged: \([0-9]*\) stored.*/\1/p' "$work/hill-car.log" | tail -n 1) - 1 ))
+step "the server's live verdict on the run, published beside its estimates (dynid estimates --model)"
+verdict=""
+for _ in $(seq 120); do
+  verdict=$("$cli" --cyclone-config "$config" estimates --vehicle "$vehicle" --run "$hill_run" \
+              --model longitudinal_wheel | grep "residual loop (chunks through #$last_chunk)" || true)
+  [ -n "$verdict" ] && break
+  sleep 0.5
+done
+[ -n "$verdict" ] || { echo "demo: no live residual verdict through chunk #$last_chunk within 60 s" >&2; exit 1; }
+echo "$verdict"
+step "the residual loop on that run (dynid trace --model longitudinal_wheel --effects none)"
 hill_truth() { sed -n "/^\[$1\]/,/^\[/p" "$work/hill/truth.toml" | awk -F' = ' -v k="$2" '$1 == k { print $2; exit }'; }
 "$cli" --cyclone-config "$config" trace --vehicle "$vehicle" --run "$hill_run" --model longitudinal_wheel \
   --effects none --reference "mass=$(hill_truth vehicle longitudinal_equivalent_mass)" \

@@ -60,6 +60,10 @@ std::optional<ServerOptions> parse_options(int argc, const char* const* argv) {
       ->check(input::within(1, kMaxCheckpointEvery));
   app.add_option("--publish-interval-ms", publish_ms, "minimum time between estimate updates")
       ->check(input::within(0, kMaxPublishIntervalMs));
+  long long live_residual_s = o.live_residual_interval.count();
+  app.add_option("--live-residual", live_residual_s,
+                 "keep the residual loop's verdict of open runs current, at most every S seconds (0: off)")
+      ->check(input::within(0, kMaxLiveResidualS));
   app.add_option("--shard", shard, "own the vehicles whose hash mod N == K (K/N)");
   app.add_option("--reorder-window", o.store.reorder_window, "chunks stored ahead of a gap")
       ->check(input::within(1, kMaxReorderWindow));
@@ -75,6 +79,7 @@ std::optional<ServerOptions> parse_options(int argc, const char* const* argv) {
   }
   o.shard = Shard::parse(shard);
   o.publish_interval = std::chrono::milliseconds(publish_ms);
+  o.live_residual_interval = std::chrono::seconds(live_residual_s);
   return o;
 }
 

@@ -1,5 +1,7 @@
 #include "dynid/server/residual_requests.hpp"
 
+#include <algorithm>
+
 #include "dynid/error.hpp"
 #include "dynid/ingest/recorded_run.hpp"
 #include "dynid/model/registry.hpp"
@@ -105,6 +107,30 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
   if (request.format == "json") return {report::comparison_json(cmp), "application/json"};
   if (request.format == "html") return {report::residual_html({title, nullptr, &cmp}), "text/html"};
   return {report::format_comparison_text(cmp), "text/plain"};
+}
+
+std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& announcement,
+                                                 const std::vector<ingest::Chunk>& chunks,
+                                                 const std::vector<std::string>& models) {
+  std::map<std::string, LiveVerdict> out;
+  const ingest::RecordedRun run = ingest::assemble_run(announcement, chunks);
+  const auto segments = ingest::preprocess_offline(run);
+  if (segments.empty()) return out;
+  residual::DiagnosisOptions options;
+  options.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
+  for (const ingest::ModelSpec& spec : announcement.models) {
+    if (std::find(models.begin(), models.end(), spec.model) == models.end()) continue;
+    try {
+      const auto model = model::make_model(spec.model, spec.constants);
+      const residual::Diagnosis d = residual::diagnose(*model, spec.effects, run, segments, options);
+      const bool measured = std::all_of(d.floor.groups.begin(), d.floor.groups.end(),
+                                        [](const residual::GroupFloor& g) { return g.rows == 0 || g.floor_rms > 0.0; });
+      if (measured) out[spec.model] = {residual::verdict_name(d.verdict), d.statement()};
+    } catch (const InputError&) {
+      // Not diagnosable yet (no row of this model so far): no verdict rather than a wrong one.
+    }
+  }
+  return out;
 }
 
 }  // namespace dynid::server

@@ -417,7 +417,81 @@ void RunService::publish_ack(const store::RunKey& key, const RunState* run,
 void RunService::publish(const store::RunKey& key, RunState& run) {
   dirty_.erase(key);
   run.last_published = std::chrono::steady_clock::now();
-  publish_tables(key.vehicle, tables_of(key.vehicle, key.run, run.processor.estimates()));
+  refresh_residual(key, run);
+  EstimateTables tables = tables_of(key.vehicle, key.run, run.processor.estimates());
+  attach_residual(run, tables);
+  publish_tables(key.vehicle, std::move(tables));
+}
+
+void RunService::refresh_residual(const store::RunKey& key, const RunState& run) {
+  if (context_.options.live_residual_interval.count() == 0 || run.contiguous < 0 ||
+      run.contiguous == run.residual_through)
+    return;
+  residual_stale_.insert(key);
+  start_residual_job();
+}
+
+void RunService::start_residual_job() {
+  if (residual_job_) return;
+  const auto now = std::chrono::steady_clock::now();
+  for (auto it = residual_stale_.begin(); it != residual_stale_.end();) {
+    RunState* run = find(*it);
+    if (run == nullptr || run->contiguous == run->residual_through) {
+      it = residual_stale_.erase(it);
+      continue;
+    }
+    if (!run->processor.finished() && run->residual_through >= 0 &&
+        now - run->residual_at < context_.options.live_residual_interval) {
+      ++it;
+      continue;
+    }
+    // Only the models this run excites: the loop's judgement of a model the run carries no
+    // information about says nothing (and costs the most: every candidate is "significant").
+    std::vector<std::string> models;
+    for (const dds::EstimateTable& t : tables_of(it->vehicle, it->run, run->processor.estimates()).tables)
+      if (t.not_excited.empty()) models.push_back(t.model);
+    std::vector<ingest::Chunk> chunks;  // read here: the store is this worker's to read
+    replay_stored(*it, *run, [&](const ingest::Chunk& chunk) { chunks.push_back(chunk); });
+    run->residual_at = now;
+    residual_job_.emplace(ResidualJob{
+        *it, run->contiguous,
+        std::async(std::launch::async,
+                   [announcement = run->processor.announcement(), chunks = std::move(chunks), models = std::move(models)] {
+                     return live_verdicts(announcement, chunks, models);
+                   })});
+    residual_stale_.erase(it);
+    return;
+  }
+}
+
+void RunService::collect_residual_job() {
+  if (!residual_job_ || residual_job_->verdicts.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+  ResidualJob job = std::move(*residual_job_);
+  residual_job_.reset();
+  std::map<std::string, LiveVerdict> verdicts;
+  try {
+    verdicts = job.verdicts.get();
+  } catch (const std::exception& e) {  // a run that cannot be assembled yet: no verdict
+    spdlog::debug("run {}: no live residual verdict: {}", label(job.key), e.what());
+  }
+  if (RunState* run = find(job.key)) {
+    run->residual = std::move(verdicts);
+    run->residual_through = job.through;
+    spdlog::debug("run {}: live residual verdict through #{}", label(job.key), job.through);
+    mark_changed(job.key, *run);  // published with the next tick
+    if (run->contiguous != run->residual_through) residual_stale_.insert(job.key);
+  }
+  start_residual_job();
+}
+
+void RunService::attach_residual(const RunState& run, EstimateTables& tables) {
+  for (dds::EstimateTable& table : tables.tables) {
+    const auto it = run.residual.find(table.model);
+    if (it == run.residual.end()) continue;
+    table.residual_verdict = it->second.verdict;
+    table.residual_statement = it->second.statement;
+    table.residual_through = static_cast<std::uint64_t>(run.residual_through);
+  }
 }
 
 void RunService::publish_tables(const std::string& vehicle, EstimateTables tables) {
@@ -458,6 +532,8 @@ void RunService::settle() {
 void RunService::publish_due(std::chrono::steady_clock::time_point now) {
   submit_pending();
   collect(false);
+  collect_residual_job();
+  start_residual_job();  // a run whose interval has passed since it was found stale
   // Only the changed runs are visited (a worker of 1000 vehicles ticks after every batch).
   std::vector<std::string> due;  // dirty_ is ordered by vehicle: a vehicle's runs are adjacent
   for (auto it = dirty_.begin(); it != dirty_.end();) {

@@ -88,8 +88,10 @@ EstimateTables RunService::estimate(const std::string& vehicle,
                                     const std::optional<std::string>& model) {
   settle();  // the chunks received before this request count, the ledger up to date
   const store::RunKey key{vehicle, run ? *run : latest_run(vehicle)};
-  const RunState& state = load(key);
+  RunState& state = load(key);
+  refresh_residual(key, state);  // a new verdict comes with a later publication
   auto tables = tables_of(vehicle, key.run, state.processor.estimates(), model);
+  attach_residual(state, tables);
   if (model && tables.tables.empty() && tables.notes.empty())
     throw NotFound("run " + vehicle + "/" + key.run + " has no model " + *model);
   if (!state.halted.empty()) tables.notes.push_back(key.run + ": " + state.halted);
@@ -168,8 +170,9 @@ EstimateTables RunService::close(const std::string& vehicle, const std::string& 
   RunState& state = load(key);
   if (!state.processor.finished()) state.processor.finish();  // folds the held-back samples
   context_.store.with([&](store::Store& s) { s.close_run(key); });
-  publish(key, state);
+  publish(key, state);  // and the finished run's live verdict, once diagnosed
   auto tables = tables_of(vehicle, run, state.processor.estimates());
+  attach_residual(state, tables);
   record_history(key, tables);
   spdlog::info("run {}/{}: closed", vehicle, run);
   return tables;

@@ -3,6 +3,7 @@
 // reports before and after, `--html` writes the self-contained page; bad requests are named.
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -153,6 +154,47 @@ TEST(E2eResidualCli, DeclaredNoiseAndParameterStatusesReachTheReports) {
   const auto& first = json.at("parameters").at(0);
   EXPECT_TRUE(first.at("status_before").is_string()) << first.dump();
   EXPECT_TRUE(first.at("status_after").is_string()) << first.dump();
+}
+
+// Issue 15 item 7: a server started with --live-residual keeps every excited model's verdict
+// current as the run streams and publishes it beside the estimates; once the run is closed, the
+// verdict includes its last chunk, and it is the one `dynid residual` gives on the stored run.
+TEST(E2eResidualCli, TheLiveVerdictIsPublishedBesideTheEstimates) {
+  TempDir dir;
+  server::ServerOptions options = server_options(dir.file("store.db"));
+  options.live_residual_interval = std::chrono::seconds(1);
+  InProcessServer server(options);
+  const auto run = test_run("live-car", "run-l", 47u);
+  const auto chunks = cut_run(run, 5u);
+  EstimateWatcher watcher("live-car");
+  TestCar car("live-car");
+  ASSERT_TRUE(car.stream(run.announcement, chunks));
+  ASSERT_EQ(dynid({"close", "--vehicle", "live-car", "--run", "run-l"}).exit_code, 0);
+
+  const std::uint64_t last = chunks.back().sequence;
+  nlohmann::json table;
+  for (int attempt = 0; attempt < 120 && table.is_null(); ++attempt) {
+    const auto reply = dynid({"--json", "estimates", "--vehicle", "live-car", "--run", "run-l", "--model",
+                              "kinematic_longitudinal"});
+    ASSERT_EQ(reply.exit_code, 0) << reply.err;
+    const auto t = nlohmann::json::parse(reply.out)["tables"][0];
+    if (t["residual_through"] == last && !t["residual_verdict"].get<std::string>().empty()) table = t;
+    else std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+  ASSERT_FALSE(table.is_null()) << "no live verdict through chunk #" << last;
+  const auto direct = dynid({"--json", "residual", "--vehicle", "live-car", "--run", "run-l", "--model",
+                             "kinematic_longitudinal"});
+  ASSERT_EQ(direct.exit_code, 0) << direct.err;
+  const auto diagnosis = nlohmann::json::parse(direct.out);
+  EXPECT_EQ(table["residual_verdict"], diagnosis["verdict"]);
+  EXPECT_EQ(table["residual_statement"], diagnosis["statement"]);
+  // On the topic too (an engineer's `dynid watch` sees it).
+  watcher.wait_for({}, "run-l", std::chrono::milliseconds(3000));  // nothing to match: reads for 3 s
+  const auto& published = watcher.latest("run-l");
+  const auto it = published.find("kinematic_longitudinal");
+  ASSERT_NE(it, published.end()) << watcher.seen();
+  EXPECT_EQ(it->second.residual_verdict, table["residual_verdict"].get<std::string>());
+  EXPECT_EQ(it->second.residual_through, last);
 }
 
 }  // namespace

@@ -40,6 +40,7 @@ TEST(HostileServer, NumericOptionsOutsideTheirLimitsAreRefusedBeforeAnything) {
       {"--threads", {"257", "1000000000", "4294967296", "-1"}, server_args(store)},
       {"--checkpoint-every", {"0", "1000001", "-1"}, server_args(store)},
       {"--publish-interval-ms", {"-1", "3600001"}, server_args(store)},
+      {"--live-residual", {"-1", "86401"}, server_args(store)},
       {"--reorder-window", {"0", "1000001"}, server_args(store)},
       {"--domain", {"-1", "231"}, server_args(store)},
   };

@@ -175,6 +175,9 @@ Sample<dynid_wire_Estimate> to_wire(const EstimateTable& table) {
     groups[k].residual_rms = table.groups[k].residual_rms;
   }
   put_text(out.not_excited, table.not_excited);
+  put_id(out.residual_verdict, table.residual_verdict, where + " residual_verdict");
+  put_text(out.residual_statement, table.residual_statement);
+  out.residual_through = table.residual_through;
   return sample;
 }
 
@@ -196,6 +199,9 @@ EstimateTable from_wire(const dynid_wire_Estimate& sample) {
   for (const auto& group : elements(sample.groups, dynid_wire_kMaxGroups, where + " groups"))
     table.groups.push_back({get(group.group, where + " group name"), group.rows, group.residual_rms});
   table.not_excited = get(sample.not_excited, where + " not_excited");
+  table.residual_verdict = get(sample.residual_verdict, where + " residual_verdict");
+  table.residual_statement = get(sample.residual_statement, where + " residual_statement");
+  table.residual_through = sample.residual_through;
   return table;
 }
 

@@ -66,6 +66,8 @@ std::string format_estimate_text(const dds::EstimateTable& t) {
   for (const auto& g : t.groups)
     out += fmt::format("  group {:<28} rows {:>8}  residual RMS {}\n", g.group, g.rows,
                        cell(g.residual_rms));
+  if (!t.residual_verdict.empty())
+    out += fmt::format("  residual loop (chunks through #{}): {}\n", t.residual_through, t.residual_statement);
   return out;
 }
 
@@ -80,11 +82,13 @@ std::string estimate_json(const dds::EstimateTable& t) {
   return fmt::format(
       "{{\"vehicle\":{},\"model\":{},\"source\":{},\"revision\":{},\"parameters\":[{}],"
       "\"rows\":{},\"effective_rows\":{},\"sigma\":{},\"condition_number\":{},"
-      "\"residual_rms\":{},\"relative_residual_norm\":{},\"groups\":[{}],\"not_excited\":{}}}",
+      "\"residual_rms\":{},\"relative_residual_norm\":{},\"groups\":[{}],\"not_excited\":{},"
+      "\"residual_verdict\":{},\"residual_statement\":{},\"residual_through\":{}}}",
       json_string(t.vehicle), json_string(t.model), json_string(t.source), t.revision, parameters,
       t.rows, json_number(t.effective_rows), json_number(t.sigma),
       json_number(t.condition_number), json_number(t.residual_rms),
-      json_number(t.relative_residual_norm), groups, json_string(t.not_excited));
+      json_number(t.relative_residual_norm), groups, json_string(t.not_excited),
+      json_string(t.residual_verdict), json_string(t.residual_statement), t.residual_through);
 }
 
 std::string estimates_json(const std::vector<dds::EstimateTable>& tables) {

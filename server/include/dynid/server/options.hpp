@@ -13,6 +13,11 @@
 //                            1..kMaxCheckpointEvery (50)
 //   --publish-interval-ms M  publish a run's estimates at most every M ms,
 //                            0..kMaxPublishIntervalMs (250)
+//   --live-residual S        keep the residual loop's verdict of every open run current, at
+//                            most every S seconds of a run's growth (and at its close), and
+//                            publish it beside the estimates; 0..kMaxLiveResidualS (0: off).
+//                            The diagnosis replays the stored run on the run's worker: it costs
+//                            that worker about a second per model and run (docs/RESIDUAL.md)
 //   --shard K/N              own the vehicles whose hash mod N == K (0/1: all)
 //   --reorder-window W       chunks stored ahead of a gap (store.hpp), 1..kMaxReorderWindow (256)
 //   --log-level L            trace, debug, info, warn, error (info)
@@ -38,6 +43,7 @@ inline constexpr unsigned kMaxThreads = 256;
 inline constexpr std::uint64_t kMaxCheckpointEvery = 1000000;
 inline constexpr long long kMaxPublishIntervalMs = 3600000;
 inline constexpr std::uint64_t kMaxReorderWindow = 1000000;
+inline constexpr long long kMaxLiveResidualS = 86400;
 
 struct ServerOptions {
   std::string store_path;
@@ -46,6 +52,7 @@ struct ServerOptions {
   unsigned threads = 0;
   std::uint64_t checkpoint_every = 50;
   std::chrono::milliseconds publish_interval{250};
+  std::chrono::seconds live_residual_interval{0};  ///< 0: the live verdict is off
   Shard shard;
   store::StoreOptions store;
   std::string log_level = "info";

@@ -51,4 +51,18 @@ struct ResidualReply {
 ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
                              const std::vector<ingest::Chunk>& chunks, const ResidualRequest& request);
 
+/// The residual loop's verdict on one model of a run (residual::Diagnosis, one line).
+struct LiveVerdict {
+  std::string verdict;    ///< "adequate", "explained", "structure left"
+  std::string statement;  ///< Diagnosis::statement()
+};
+
+/// The verdict of each of `models` (announced models, with their declared effects) on the run so
+/// far: what a server started with --live-residual publishes beside the estimates. A model that
+/// cannot be diagnosed yet (no row, no valid segment long enough to filter, a noise floor that
+/// cannot be measured on so little) is left out, not an error.
+std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& announcement,
+                                                 const std::vector<ingest::Chunk>& chunks,
+                                                 const std::vector<std::string>& models);
+
 }  // namespace dynid::server

@@ -45,6 +45,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <future>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -160,6 +161,12 @@ class RunService {
     std::chrono::steady_clock::time_point last_published{};
     std::optional<std::uint64_t> unsaved_fold;  // folded through, not yet in the ledger
     std::vector<UnsavedCheckpoint> unsaved_checkpoints;
+    // The live residual verdict (--live-residual): per model, and the chunks it includes.
+    std::map<std::string, LiveVerdict> residual;
+    std::int64_t residual_through = -1;
+    // The first verdict waits an interval from the run's load (or its close): a few chunks carry
+    // too little to measure a noise floor on.
+    std::chrono::steady_clock::time_point residual_at = std::chrono::steady_clock::now();
   };
   struct PendingChunk {
     store::RunKey key;
@@ -214,6 +221,15 @@ class RunService {
   static void write_folds(store::Store& s, const std::vector<SavedFold>& folds,
                           ServerCounters& counters);
   void publish(const store::RunKey& key, RunState& run);
+  /// With the live verdict on, a run that has grown since its verdict is due a new one
+  /// (residual_requests.hpp: live_verdicts()), started once the interval has passed or the run
+  /// is finished and no other diagnosis of this worker is in flight.
+  void refresh_residual(const store::RunKey& key, const RunState& run);
+  void start_residual_job();
+  /// A finished diagnosis into its run, which is then published again.
+  void collect_residual_job();
+  /// The run's live verdicts into its tables (nothing when off or not computed).
+  static void attach_residual(const RunState& run, EstimateTables& tables);
   void publish_tables(const std::string& vehicle, EstimateTables tables);
   /// Publishes now every run of `vehicle` whose estimates changed since their last publication,
   /// in the order they changed.
@@ -232,6 +248,16 @@ class RunService {
   std::function<void()> wake_;
   std::uint64_t changes_ = 0;          // RunState::changed counter
   std::set<store::RunKey> dirty_;      // runs whose estimates changed since their publication
+  // The live residual verdict (--live-residual): runs whose verdict is older than their chunks,
+  // and the one diagnosis in flight. One job per worker at a time, on a thread of its own: the
+  // diagnoses take one core beside the folding and never hold an acknowledgement back.
+  struct ResidualJob {
+    store::RunKey key;
+    std::int64_t through = -1;
+    std::future<std::map<std::string, LiveVerdict>> verdicts;
+  };
+  std::set<store::RunKey> residual_stale_;
+  std::optional<ResidualJob> residual_job_;
   std::vector<store::RunKey> unsaved_;  // runs whose folded mark or checkpoint is not saved
   VehicleOutputs outputs_;
 };

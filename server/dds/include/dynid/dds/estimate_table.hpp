@@ -50,6 +50,13 @@ struct EstimateTable {
   std::vector<GroupResidual> groups;
   /// "" unless the source excites none of the parameters; then what would ("needs d_vx (...)").
   std::string not_excited = {};
+  /// The residual loop's verdict on the run so far (residual/diagnosis.hpp), kept current by a
+  /// server started with a live-residual interval: "adequate", "explained" or "structure left";
+  /// "" when not computed (off, a pool, no row yet). The statement says why (cut to the wire's
+  /// bound); `residual_through` is the last chunk it includes.
+  std::string residual_verdict = {};
+  std::string residual_statement = {};
+  std::uint64_t residual_through = 0;
 };
 
 EstimateTable make_estimate_table(const std::string& vehicle, const std::string& model,
