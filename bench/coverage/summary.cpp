@@ -36,6 +36,27 @@ StdCoverage coverage_of(const std::vector<double>& errors, const std::vector<dou
   return c;
 }
 
+IvCoverage iv_of(const std::vector<const ParameterSample*>& samples) {
+  IvCoverage c;
+  std::vector<double> textbook, hac;
+  int rejections = 0;
+  for (const ParameterSample* s : samples) {
+    if (!s->iv_refused.empty()) ++c.refused;
+    if (!std::isfinite(s->iv_value) || !std::isfinite(s->iv_std) || !std::isfinite(s->iv_hac_std)) continue;
+    c.errors_pct.push_back(100.0 * s->iv_relative_error());
+    textbook.push_back(100.0 * s->iv_std / std::abs(s->truth));
+    hac.push_back(100.0 * s->iv_hac_std / std::abs(s->truth));
+    rejections += s->dwh_rejects ? 1 : 0;
+  }
+  c.seeds = static_cast<int>(c.errors_pct.size());
+  c.mean_error_pct = mean(c.errors_pct);
+  c.scatter_pct = scatter(c.errors_pct);
+  c.textbook = coverage_of(c.errors_pct, textbook);
+  c.hac = coverage_of(c.errors_pct, hac);
+  c.dwh_rejections = c.seeds > 0 ? static_cast<double>(rejections) / c.seeds : kNaN;
+  return c;
+}
+
 ParameterCoverage row_of(const std::vector<const ParameterSample*>& samples) {
   ParameterCoverage row;
   row.model = samples.front()->model;
@@ -54,6 +75,7 @@ ParameterCoverage row_of(const std::vector<const ParameterSample*>& samples) {
   row.scatter_pct = scatter(errors);
   row.table = coverage_of(errors, table);
   row.hac = coverage_of(errors, hac);
+  row.iv = iv_of(samples);
   return row;
 }
 
@@ -92,6 +114,22 @@ std::string markdown_table(const std::vector<ParameterCoverage>& rows) {
     std::snprintf(b, sizeof b, "| %s | %s | %.6g | %d | %+.3g %% | %.3g %% |", r.model.c_str(), r.parameter.c_str(),
                   r.truth, r.seeds, r.mean_error_pct, r.scatter_pct);
     out += b + cells(r.table) + cells(r.hac) + "\n";
+  }
+  return out;
+}
+
+std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows) {
+  std::string out =
+      "| model | parameter | LS mean error | IV seeds | IV mean error | IV scatter | IV std | within 2 IV std | mean error / "
+      "IV std | IV HAC std | within 2 IV HAC std | mean error / IV HAC std | DWH rejects at 1 % |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const ParameterCoverage& r : rows) {
+    char b[200];
+    std::snprintf(b, sizeof b, "| %s | %s | %+.3g %% | %d | %+.3g %% | %.3g %% |", r.model.c_str(), r.parameter.c_str(),
+                  r.mean_error_pct, r.iv.seeds, r.iv.mean_error_pct, r.iv.scatter_pct);
+    char d[40];
+    std::snprintf(d, sizeof d, " %.0f %% |\n", 100.0 * r.iv.dwh_rejections);
+    out += b + cells(r.iv.textbook) + cells(r.iv.hac) + d;
   }
   return out;
 }

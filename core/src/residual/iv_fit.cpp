@@ -23,6 +23,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Lags searched by instrument_lag, decimated rows: far beyond any Butterworth of order <= 8 at
 // DYCARO's cut-off, whose impulse response dies out within a few decimated rows.
 constexpr int kLongestLag = 64;
+// Consecutive lags (and as many leads) taken as instruments from L on: see the header.
+constexpr int kSpan = 3;
 
 double autocorrelation(const Eigen::VectorXd& h, Eigen::Index lag) {
   const Eigen::Index n = h.size() - lag;
@@ -44,7 +46,8 @@ void validate(const IvOptions& o) {
   if (!(o.min_instrument_f >= 0.0)) throw InputError("iv_fit: min_instrument_f must be >= 0");
 }
 
-// The weighted rows that have an instrument: W (identifiable columns only), Z, y, grid index.
+// The weighted rows that have an instrument: W (identifiable columns only), Z (one block of W's
+// columns per offset, zero where that partner is not a row), y, grid index.
 struct Stacked {
   Eigen::MatrixXd w, z;
   Eigen::VectorXd y;
@@ -68,28 +71,27 @@ long partner_of(const std::vector<Eigen::Index>& grids, Eigen::Index grid, long 
 }
 
 Stacked stack_rows(const detail::FoldedRows& rows, const std::vector<ingest::PreprocessedSegment>& run,
-                   const std::vector<Eigen::Index>& used, const std::vector<double>& weights, Eigen::Index step) {
+                   const std::vector<Eigen::Index>& used, const std::vector<double>& weights,
+                   const std::vector<Eigen::Index>& offsets) {
   const auto width = static_cast<Eigen::Index>(rows.parameters.size());
   const auto k = static_cast<Eigen::Index>(used.size());
   std::vector<double> w, z, y;
   Stacked out;
+  std::vector<long> partners(offsets.size());
   for (std::size_t g = 0; g < rows.collected.values.size(); ++g) {
     const std::vector<Eigen::Index>& grids = rows.collected.grid_index[g];
     const double* values = rows.collected.values[g].data();
     const auto at = [&](long i, Eigen::Index j) { return values[i * (width + 1) + j]; };
     for (std::size_t i = 0; i < grids.size(); ++i) {
       const long segment = segment_of(run, grids[i]);
-      const long before = partner_of(grids, grids[i] - step, segment, run);
-      const long after = partner_of(grids, grids[i] + step, segment, run);
-      if (before < 0 && after < 0) {
+      for (std::size_t o = 0; o < offsets.size(); ++o) partners[o] = partner_of(grids, grids[i] + offsets[o], segment, run);
+      if (std::all_of(partners.begin(), partners.end(), [](long p) { return p < 0; })) {
         ++out.without_partner;
         continue;
       }
-      const double share = before >= 0 && after >= 0 ? 0.5 : 1.0;
-      for (Eigen::Index j : used) {
-        w.push_back(weights[g] * at(static_cast<long>(i), j));
-        z.push_back(weights[g] * share * ((before >= 0 ? at(before, j) : 0.0) + (after >= 0 ? at(after, j) : 0.0)));
-      }
+      for (Eigen::Index j : used) w.push_back(weights[g] * at(static_cast<long>(i), j));
+      for (long p : partners)
+        for (Eigen::Index j : used) z.push_back(p >= 0 ? weights[g] * at(p, j) : 0.0);
       y.push_back(weights[g] * at(static_cast<long>(i), width));
       out.grid.push_back(grids[i]);
     }
@@ -97,14 +99,21 @@ Stacked stack_rows(const detail::FoldedRows& rows, const std::vector<ingest::Pre
   const auto n = static_cast<Eigen::Index>(y.size());
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   out.w = Eigen::Map<const RowMajor>(w.data(), n, k);
-  out.z = Eigen::Map<const RowMajor>(z.data(), n, k);
+  out.z = Eigen::Map<const RowMajor>(z.data(), n, k * static_cast<Eigen::Index>(offsets.size()));
   out.y = Eigen::Map<const Eigen::VectorXd>(y.data(), n);
   return out;
 }
 
-Eigen::MatrixXd thin_q(const Eigen::MatrixXd& a) {
-  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(a);
-  return qr.householderQ() * Eigen::MatrixXd::Identity(a.rows(), a.cols());
+// An orthonormal basis of the instruments' span, on unit-scaled columns (the offset column
+// repeats in every block, and a block can be all zeros where its partner is never a row: the
+// rank is the number of distinct instruments).
+Eigen::MatrixXd instrument_basis(const Eigen::MatrixXd& z) {
+  const Eigen::VectorXd norms = z.colwise().norm().transpose();
+  Eigen::VectorXd scale = Eigen::VectorXd::Zero(norms.size());
+  for (Eigen::Index j = 0; j < norms.size(); ++j)
+    if (norms(j) > 0.0) scale(j) = 1.0 / norms(j);
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(z * scale.asDiagonal());
+  return qr.householderQ() * Eigen::MatrixXd::Identity(z.rows(), qr.rank());
 }
 
 // Weak-instrument check on unit-scaled columns: the smallest canonical correlation, its
@@ -121,11 +130,11 @@ Instruments instrument_strength(const Eigen::MatrixXd& qz, const Eigen::MatrixXd
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(qz.transpose() * qw, Eigen::ComputeFullV);
   Instruments out;
   const Eigen::Index k = ws.cols();
-  out.r_min = std::min(1.0, svd.singularValues()(k - 1));
+  out.r_min = qz.cols() < k ? 0.0 : std::min(1.0, svd.singularValues()(k - 1));
   const double n = static_cast<double>(ws.rows());
+  const auto instruments = static_cast<double>(qz.cols());
   out.f = out.r_min >= 1.0 ? std::numeric_limits<double>::infinity()
-                           : (n - static_cast<double>(k)) / static_cast<double>(k) * out.r_min * out.r_min /
-                                 (1.0 - out.r_min * out.r_min);
+                           : (n - instruments) / instruments * out.r_min * out.r_min / (1.0 - out.r_min * out.r_min);
   // The direction in parameter space: W a = Q_w v, a = R^-1 v.
   const Eigen::VectorXd a =
       qr.matrixQR().topRows(k).triangularView<Eigen::Upper>().solve(svd.matrixV().col(k - 1));
@@ -173,15 +182,16 @@ Eigen::VectorXd unscaled(const Eigen::VectorXd& v, const Eigen::VectorXd& scale,
 }
 
 // The estimates, their std and the test on the stacked rows (columns unit-scaled by `scale`).
-void estimate(const Stacked& s, const Eigen::VectorXd& scale, const std::vector<Eigen::Index>& used, int odmf,
-              const IvOptions& options, IvFit& fit) {
+// Two-stage least squares: the instrument of the formulas is W's projection on the instruments'
+// span, zs = P_Z W (the first stage), so that theta_IV = (zs'W)^-1 zs'y.
+void estimate(const Stacked& s, const Eigen::MatrixXd& qz, const Eigen::VectorXd& scale,
+              const std::vector<Eigen::Index>& used, int odmf, const IvOptions& options, IvFit& fit) {
   const auto width = static_cast<Eigen::Index>(fit.parameters.size());
   const Eigen::MatrixXd ws = s.w * scale.asDiagonal();
-  const Eigen::MatrixXd zs = s.z * scale.asDiagonal();
-  const Eigen::MatrixXd qz = thin_q(zs);
-  // Z = Q_z R_z with R_z invertible: Z'(y - W theta) = 0 is Q_z'(y - W theta) = 0, solved without
-  // forming Z'W (whose condition number is the square of the columns').
-  const Eigen::VectorXd iv = (qz.transpose() * ws).colPivHouseholderQr().solve(qz.transpose() * s.y);
+  const Eigen::MatrixXd zs = qz * (qz.transpose() * ws);
+  // zs'W = zs'zs: theta_IV is the least-squares solution of zs theta = y, solved by QR without
+  // forming zs'W (whose condition number is the square of the columns').
+  const Eigen::VectorXd iv = zs.colPivHouseholderQr().solve(s.y);
   const Eigen::VectorXd ls = ws.colPivHouseholderQr().solve(s.y);
   const Eigen::MatrixXd m_inverse = (zs.transpose() * ws).colPivHouseholderQr().inverse();
   const Eigen::MatrixXd g_inverse = (ws.transpose() * ws).ldlt().solve(Eigen::MatrixXd::Identity(ws.cols(), ws.cols()));
@@ -200,6 +210,16 @@ void estimate(const Stacked& s, const Eigen::VectorXd& scale, const std::vector<
   fit.std = unscaled(textbook.diagonal().cwiseMax(0.0).cwiseSqrt(), scale, used, width);
   fit.hac_std = unscaled(hac.diagonal().cwiseMax(0.0).cwiseSqrt(), scale, used, width);
   fit.dwh = hausman(iv - ls, v_d, bandwidth, options.level);
+}
+
+// The instruments' grid offsets: lags and leads L .. L + kSpan - 1 decimated rows.
+std::vector<Eigen::Index> offsets(int lag_rows, int odmf) {
+  std::vector<Eigen::Index> out;
+  for (int l = lag_rows; l < lag_rows + kSpan; ++l) {
+    out.push_back(-static_cast<Eigen::Index>(l) * odmf);
+    out.push_back(static_cast<Eigen::Index>(l) * odmf);
+  }
+  return out;
 }
 
 // Refuses IV with `reason`: every value NaN.
@@ -221,7 +241,7 @@ std::string unusable(const Stacked& s, const Eigen::VectorXd& scale, const std::
                      const IvFit& fit, const IvOptions& options, const Instruments& strength) {
   const Eigen::Index k = s.w.cols();
   if (k == 0) return "the least-squares fit identifies no parameter";
-  if (s.y.size() <= 2 * k) return "only " + std::to_string(s.y.size()) + " rows have an instrument";
+  if (s.y.size() <= s.z.cols() + k) return "only " + std::to_string(s.y.size()) + " rows have an instrument";
   if ((s.w * scale.asDiagonal()).colPivHouseholderQr().rank() < k)
     return "the rows with an instrument do not identify every base parameter";
   if (!(strength.f >= options.min_instrument_f))
@@ -267,13 +287,15 @@ IvFit iv_fit(const model::Model& model, const std::vector<std::string>& effects,
   std::vector<Eigen::Index> used;  // the base parameters of the LS fit
   for (Eigen::Index j = 0; j < ls.all.value.size(); ++j)
     if (std::isfinite(ls.all.value(j))) used.push_back(j);
-  const Stacked s = stack_rows(rows, run, used, ls.estimator_weights, static_cast<Eigen::Index>(fit.lag_rows) * odmf);
+  const Stacked s = stack_rows(rows, run, used, ls.estimator_weights, offsets(fit.lag_rows, odmf));
   fit.rows = static_cast<std::uint64_t>(s.y.size());
   fit.rows_without_partner = s.without_partner;
   const Eigen::VectorXd scale = column_scale(s.w);
   Instruments strength;
-  if (!used.empty() && s.y.size() > 2 * s.w.cols()) {
-    strength = instrument_strength(thin_q(s.z * scale.asDiagonal()), s.w * scale.asDiagonal());
+  Eigen::MatrixXd qz;
+  if (!used.empty() && s.y.size() > s.z.cols() + s.w.cols()) {
+    qz = instrument_basis(s.z);
+    strength = instrument_strength(qz, s.w * scale.asDiagonal());
     fit.smallest_canonical_correlation = strength.r_min;
     fit.instrument_f = strength.f;
   }
@@ -281,7 +303,7 @@ IvFit iv_fit(const model::Model& model, const std::vector<std::string>& effects,
     refuse(fit, reason);
     return fit;
   }
-  estimate(s, scale, used, odmf, options, fit);
+  estimate(s, qz, scale, used, odmf, options, fit);
   return fit;
 }
 

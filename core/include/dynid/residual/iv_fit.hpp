@@ -10,16 +10,22 @@
 // with the noise variance). An instrument is anything correlated with the regressors' signal and
 // not with the noise; IV then solves Z' (y - W theta) = 0 instead of W' (y - W theta) = 0.
 //
-// Instruments, generic for every model: the model's own row built a few decimated rows earlier
-// and later, z_k = (w_{k-L} + w_{k+L}) / 2 (only one of them where the other is not a row of the
-// same group in the same valid segment; a row with neither is left out). The channels' noise,
-// low-passed by the run's zero-phase Butterworth, is correlated over the filter's impulse
-// response only, while the manoeuvre's signal persists over seconds; beyond that span the lagged
-// rows carry the signal and none of the row's noise. Both sides, averaged: the lead and the lag
-// see independent noise, so their mean carries half its variance, and for a smooth signal it is
-// the row's own signal up to L^2 w'' / 2. Nothing is model-specific: the rows are fold_rows'
-// (as fit_model builds them, effects included), and a column without noise (an offset, a known
-// input) instruments itself.
+// Instruments, generic for every model: the model's own rows built L, L + 1 and L + 2 decimated
+// rows earlier and later (six blocks of the row's columns; a block reads 0 where that partner is
+// not a row of the same group in the same valid segment, and a row with no partner at all is left
+// out). The channels' noise, low-passed by the run's zero-phase Butterworth, is correlated over
+// the filter's impulse response only, while the manoeuvre's signal persists over seconds; beyond
+// that span the lagged rows carry the signal and none of the row's noise. Nothing is
+// model-specific: the rows are fold_rows' (as fit_model builds them, effects included), and a
+// column without noise (an offset, a known input) instruments itself.
+// Why lags and leads as separate instruments, several of them (two-stage least squares through
+// the first stage's projection P_Z W): one lag, or the mean of a lag and a lead, carries a
+// sinusoid of frequency f with the factor cos(2 pi f L), and a multisine manoeuvre (the lateral
+// run's steer) can cancel itself out in it (measured: the mean of lag and lead left the lateral
+// model with a smallest canonical correlation of 0.02). Lags and leads span the sine and cosine
+// parts of each frequency, and three consecutive ones per side let the first stage interpolate
+// each column across the noise's gap (value, slope and curvature on each side); no more, because
+// 2SLS's small-sample bias towards LS grows with the number of instruments.
 //
 // The lag L (instrument_lag): the smallest number of decimated rows from which on the
 // autocorrelation of the preprocessed noise, |rho(l odmf)|, stays within `noise_correlation_bound`
@@ -33,15 +39,17 @@
 //
 // Estimate: every row weighted by its group's 1/sigma_j from the weighted LS fit of the same
 // configuration (DYCARO's weights, as the estimate table), columns scaled to unit norm for the
-// solves, theta_IV = (Z'W)^-1 Z'y by a column-pivoting QR. Only the columns the LS fit identifies
-// (its base parameters) are estimated; the others read NaN.
+// solves. With Z^ = P_Z W, theta_IV = (Z^'W)^-1 Z^'y (= (Z'W)^-1 Z'y when there are as many
+// instruments as columns), solved as the least-squares problem Z^ theta = y by a column-pivoting
+// QR (Z^'W = Z^'Z^). Only the columns the LS fit identifies (its base parameters) are estimated;
+// the others read NaN.
 //
-// Standard deviations, both given: `std` is the textbook s^2 (Z'W)^-1 Z'Z (W'Z)^-1, s^2 the IV
-// residual's variance (comparable to the estimate table's sigma^2 (W'W)^-1); `hac_std` is the
-// sandwich (Z'W)^-1 S (W'Z)^-1 with S the long-run covariance of the scores z_k e_k, taken as
-// hac_wald.hpp takes it (VAR(1)-prewhitened Newey-West, Andrews' bandwidth): the rows are
-// low-passed and decimated, their errors correlated, and the textbook formula counts each row as
-// independent.
+// Standard deviations, both given (Z^ in place of Z): `std` is the textbook s^2 (Z'W)^-1 Z'Z
+// (W'Z)^-1, s^2 the IV residual's variance (comparable to the estimate table's sigma^2 (W'W)^-1);
+// `hac_std` is the sandwich (Z'W)^-1 S (W'Z)^-1 with S the long-run covariance of the scores
+// z_k e_k, taken as hac_wald.hpp takes it (VAR(1)-prewhitened Newey-West, Andrews' bandwidth):
+// the rows are low-passed and decimated, their errors correlated, and the textbook formula
+// counts each row as independent.
 //
 // Durbin-Wu-Hausman: d = theta_IV - theta_LS (LS weighted alike, on the same rows), H = d' V_d^+ d,
 // chi-square with rank(V_d) degrees of freedom under "the regressors' noise does not bias LS".
@@ -53,10 +61,11 @@
 // the largest.
 //
 // Weak instruments: with weak instruments IV is biased towards LS and its std is unreliable. The
-// check is the Cragg-Donald statistic F = (n - k) / k * r^2 / (1 - r^2) of the smallest canonical
-// correlation r between the weighted instruments and regressors (the least well instrumented
-// direction of the parameters); IV is refused below `min_instrument_f` (10, Staiger and Stock's
-// rule), naming the parameter that direction weighs most. The rows' correlation makes n overstate
+// check is the Cragg-Donald statistic F = (n - K) / K * r^2 / (1 - r^2) of the smallest canonical
+// correlation r between the K weighted instruments (distinct ones: the rank of Z) and the k
+// regressors (the least well instrumented direction of the parameters); IV is refused below
+// `min_instrument_f` (10, Staiger and Stock's rule), naming the parameter that direction weighs
+// most. The rows' correlation makes n overstate
 // the information: a stated limit, the check is a floor, not a guarantee.
 #include <cstdint>
 #include <string>
