@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 namespace dynid::benchcoverage {
 namespace {
@@ -85,6 +86,30 @@ std::string cells(const StdCoverage& c) {
   return b;
 }
 
+// printf into a string (the cells of a table line).
+template <typename... Args>
+std::string formatted(const char* pattern, Args... args) {
+  char b[200];
+  std::snprintf(b, sizeof b, pattern, args...);
+  return b;
+}
+
+// A table line's first cells, "| model | parameter | ", then `pattern`.
+template <typename... Args>
+std::string start(const ParameterCoverage& r, const char* pattern, Args... args) {
+  return "| " + r.model + " | " + r.parameter + " | " + formatted(pattern, args...);
+}
+
+// A markdown table: the header line, its separator, one line per row.
+std::string table(const std::string& header, const std::vector<ParameterCoverage>& rows,
+                  const std::function<std::string(const ParameterCoverage&)>& line) {
+  std::string out = header + "\n";
+  for (std::size_t c = 1; c < static_cast<std::size_t>(std::count(header.begin(), header.end(), '|')); ++c) out += "|---";
+  out += "|\n";
+  for (const ParameterCoverage& r : rows) out += line(r) + "\n";
+  return out;
+}
+
 }  // namespace
 
 std::vector<ParameterCoverage> summarize(const std::vector<SeedRun>& runs) {
@@ -105,33 +130,22 @@ std::vector<ParameterCoverage> summarize(const std::vector<SeedRun>& runs) {
 }
 
 std::string markdown_table(const std::vector<ParameterCoverage>& rows) {
-  std::string out =
-      "| model | parameter | truth | seeds | mean error | scatter | table std | within 2 table std | mean error / "
-      "table std | HAC std | within 2 HAC std | mean error / HAC std |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  for (const ParameterCoverage& r : rows) {
-    char b[200];
-    std::snprintf(b, sizeof b, "| %s | %s | %.6g | %d | %+.3g %% | %.3g %% |", r.model.c_str(), r.parameter.c_str(),
-                  r.truth, r.seeds, r.mean_error_pct, r.scatter_pct);
-    out += b + cells(r.table) + cells(r.hac) + "\n";
-  }
-  return out;
+  return table("| model | parameter | truth | seeds | mean error | scatter | table std | within 2 table std | mean error / "
+               "table std | HAC std | within 2 HAC std | mean error / HAC std |",
+               rows, [](const ParameterCoverage& r) {
+                 return start(r, "%.6g | %d | %+.3g %% | %.3g %% |", r.truth, r.seeds, r.mean_error_pct, r.scatter_pct) +
+                        cells(r.table) + cells(r.hac);
+               });
 }
 
 std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows) {
-  std::string out =
-      "| model | parameter | LS mean error | IV seeds | IV mean error | IV scatter | IV std | within 2 IV std | mean error / "
-      "IV std | IV HAC std | within 2 IV HAC std | mean error / IV HAC std | DWH rejects at 1 % |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  for (const ParameterCoverage& r : rows) {
-    char b[200];
-    std::snprintf(b, sizeof b, "| %s | %s | %+.3g %% | %d | %+.3g %% | %.3g %% |", r.model.c_str(), r.parameter.c_str(),
-                  r.mean_error_pct, r.iv.seeds, r.iv.mean_error_pct, r.iv.scatter_pct);
-    char d[40];
-    std::snprintf(d, sizeof d, " %.0f %% |\n", 100.0 * r.iv.dwh_rejections);
-    out += b + cells(r.iv.textbook) + cells(r.iv.hac) + d;
-  }
-  return out;
+  return table("| model | parameter | LS mean error | IV seeds | IV mean error | IV scatter | IV std | within 2 IV std | "
+               "mean error / IV std | IV HAC std | within 2 IV HAC std | mean error / IV HAC std | DWH rejects at 1 % |",
+               rows, [](const ParameterCoverage& r) {
+                 return start(r, "%+.3g %% | %d | %+.3g %% | %.3g %% |", r.mean_error_pct, r.iv.seeds,
+                              r.iv.mean_error_pct, r.iv.scatter_pct) +
+                        cells(r.iv.textbook) + cells(r.iv.hac) + formatted(" %.0f %% |", 100.0 * r.iv.dwh_rejections);
+               });
 }
 
 }  // namespace dynid::benchcoverage
