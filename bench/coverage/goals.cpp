@@ -17,14 +17,14 @@ std::string std_verdict(const char* which, const StdCoverage& c) {
   return b;
 }
 
-std::string accuracy_verdict(const ParameterCoverage& r) {
-  const double goal = accuracy_goal_pct(r.parameter);
+std::string accuracy_verdict(const std::string& parameter, double mean_error_pct, const std::vector<double>& errors_pct) {
+  const double goal = accuracy_goal_pct(parameter);
   if (std::isnan(goal)) return "no accuracy goal";
   int within = 0;
-  for (double e : r.errors_pct) within += std::abs(e) <= goal ? 1 : 0;
+  for (double e : errors_pct) within += std::abs(e) <= goal ? 1 : 0;
   char b[200];
-  std::snprintf(b, sizeof b, "accuracy goal %.1f %%: mean error %+.2f %% %s, %d of %d seeds within", goal,
-                r.mean_error_pct, std::abs(r.mean_error_pct) <= goal ? "within" : "OUTSIDE", within, r.seeds);
+  std::snprintf(b, sizeof b, "accuracy goal %.1f %%: mean error %+.2f %% %s, %d of %zu seeds within", goal,
+                mean_error_pct, std::abs(mean_error_pct) <= goal ? "within" : "OUTSIDE", within, errors_pct.size());
   return b;
 }
 
@@ -44,7 +44,20 @@ std::string verdicts(const std::vector<ParameterCoverage>& rows) {
   std::string out;
   for (const ParameterCoverage& r : rows)
     out += "- " + r.model + " " + r.parameter + ": " + std_verdict("table", r.table) + "; " + std_verdict("HAC", r.hac) +
-           "; " + accuracy_verdict(r) + "\n";
+           "; " + accuracy_verdict(r.parameter, r.mean_error_pct, r.errors_pct) + "\n";
+  return out;
+}
+
+std::string iv_verdicts(const std::vector<ParameterCoverage>& rows) {
+  std::string out;
+  for (const ParameterCoverage& r : rows) {
+    char b[120];
+    std::snprintf(b, sizeof b, "; %d seeds refused; DWH rejects at 1 %% in %.0f %%", r.iv.refused,
+                  100.0 * r.iv.dwh_rejections);
+    out += "- " + r.model + " " + r.parameter + " by IV: " + std_verdict("IV", r.iv.textbook) + "; " +
+           std_verdict("IV HAC", r.iv.hac) + "; " + accuracy_verdict(r.parameter, r.iv.mean_error_pct, r.iv.errors_pct) +
+           b + "\n";
+  }
   return out;
 }
 

@@ -19,4 +19,7 @@ double accuracy_goal_pct(const std::string& parameter);
 /// One line per row: whether each std meets the coverage goals, and the accuracy goal when there is one.
 std::string verdicts(const std::vector<ParameterCoverage>& rows);
 
+/// The same for the instrumental-variable estimate, with its refusals and DWH rejection rate.
+std::string iv_verdicts(const std::vector<ParameterCoverage>& rows);
+
 }  // namespace dynid::benchcoverage

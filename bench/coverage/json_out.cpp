@@ -15,7 +15,9 @@ nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : 
 nlohmann::json sample_json(const ParameterSample& s) {
   return {{"model", s.model},         {"parameter", s.parameter}, {"truth", number(s.truth)},
           {"value", number(s.value)}, {"std", number(s.std)},     {"hac_value", number(s.hac_value)},
-          {"hac_std", number(s.hac_std)}};
+          {"hac_std", number(s.hac_std)},     {"iv_value", number(s.iv_value)}, {"iv_std", number(s.iv_std)},
+          {"iv_hac_std", number(s.iv_hac_std)}, {"dwh_rejects", s.dwh_rejects}, {"iv_refused", s.iv_refused},
+          {"iv_instrument_f", number(s.iv_instrument_f)}};
 }
 
 nlohmann::json run_json(const SeedRun& r) {
@@ -42,7 +44,15 @@ nlohmann::json row_json(const ParameterCoverage& r) {
           {"mean_error_pct", number(r.mean_error_pct)},
           {"scatter_pct", number(r.scatter_pct)},
           {"table", std_json(r.table)},
-          {"hac", std_json(r.hac)}};
+          {"hac", std_json(r.hac)},
+          {"iv",
+           {{"seeds", r.iv.seeds},
+            {"refused", r.iv.refused},
+            {"mean_error_pct", number(r.iv.mean_error_pct)},
+            {"scatter_pct", number(r.iv.scatter_pct)},
+            {"textbook", std_json(r.iv.textbook)},
+            {"hac", std_json(r.iv.hac)},
+            {"dwh_rejections", number(r.iv.dwh_rejections)}}}};
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 #pragma once
 // --json FILE: every seed's values (manoeuvre, seed, run time, error text; per parameter the
-// truth, the value and both std, the HAC fit's own value), and the summary rows, for plots and
-// for checking the table by hand.
+// truth, the value and both std, the HAC fit's own value; the IV value, its two std, the model's
+// DWH verdict, instruments' F and any refusal), and the summary rows, for plots and for checking
+// the tables by hand.
 #include <string>
 #include <vector>
 

@@ -16,6 +16,7 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
                std::vector<ParameterSample>& out) {
   const residual::ModelFit fit = benchcar::declared_fit(profile, model, run.product.recorded, run.segments);
   const residual::ModelParameters hac = benchcar::declared_hac(profile, model, run.product.recorded, run.segments);
+  const residual::IvFit iv = benchcar::declared_iv(profile, model, run.product.recorded, run.segments);
   for (std::size_t i = 0; i < fit.parameters.size(); ++i) {
     const std::string& name = fit.parameters[i].name;
     const auto truth = run.truth.parameters.find(name);
@@ -31,6 +32,14 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
       s.hac_value = hac.value(k);
       s.hac_std = hac.std(k);
     }
+    if (i < iv.parameters.size() && iv.parameters[i].name == name) {
+      s.iv_value = iv.value(k);
+      s.iv_std = iv.std(k);
+      s.iv_hac_std = iv.hac_std(k);
+    }
+    s.dwh_rejects = iv.dwh.rejects;
+    s.iv_instrument_f = iv.instrument_f;
+    s.iv_refused = iv.reason;
     out.push_back(s);
   }
 }
@@ -38,6 +47,8 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
 }  // namespace
 
 double ParameterSample::relative_error() const { return (value - truth) / std::abs(truth); }
+
+double ParameterSample::iv_relative_error() const { return (iv_value - truth) / std::abs(truth); }
 
 const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre) {
   static const std::vector<std::string> longitudinal = {"longitudinal_wheel", "longitudinal_engine"};

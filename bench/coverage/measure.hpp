@@ -3,7 +3,8 @@
 // normal sensor noise, no effect injected), every model identified on that manoeuvre fitted as
 // the profile declares it, and for each parameter with a known truth its value with the two
 // standard deviations the product reports (car/declared_fit.hpp): the estimate table's (DYCARO's
-// weighted LS) and the HAC one of `dynid consistency`.
+// weighted LS) and the HAC one of `dynid consistency`; and the instrumental-variable estimate
+// (residual::iv_fit) with its std and the Durbin-Wu-Hausman test against LS.
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -26,9 +27,17 @@ struct ParameterSample {
   double std = kNaN;        ///< its std, sigma^2 (W'W)^-1
   double hac_value = kNaN;  ///< residual::hac_parameters' value (the same estimator)
   double hac_std = kNaN;
+  /// Instrumental variables (residual::iv_fit) on the rows that have an instrument.
+  double iv_value = kNaN;   ///< NaN: refused (iv_refused says why) or not identifiable
+  double iv_std = kNaN;     ///< textbook s^2 (Z'W)^-1 Z'Z (W'Z)^-1
+  double iv_hac_std = kNaN; ///< HAC sandwich
+  bool dwh_rejects = false; ///< the model's Durbin-Wu-Hausman test rejects at 1 %
+  double iv_instrument_f = kNaN;  ///< the model's Cragg-Donald F (weak-instrument check)
+  std::string iv_refused;   ///< the refusal's reason, empty when IV was estimated
   /// (value - truth) / |truth|: relative, so that a negative truth (the clutch's viscous slope)
   /// keeps the error's sign.
   double relative_error() const;
+  double iv_relative_error() const;
 };
 
 struct SeedRun {

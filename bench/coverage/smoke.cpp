@@ -29,6 +29,10 @@ std::vector<std::string> check_seed(const SeedRun& r) {
     if (!(std::abs(s.hac_value - s.value) <= kSameEstimate * std::abs(s.value)))
       failed.push_back(what + ": the HAC fit's value differs from the table's");
     if (!(std::abs(s.relative_error()) <= kErrorBound)) failed.push_back(what + ": error above 5 %");
+    if (!s.iv_refused.empty()) failed.push_back(what + ": IV refused: " + s.iv_refused);
+    if (!positive(s.iv_value) || !positive(s.iv_std) || !positive(s.iv_hac_std))
+      failed.push_back(what + ": IV value or std not finite and positive");
+    if (!(std::abs(s.iv_relative_error()) <= kErrorBound)) failed.push_back(what + ": IV error above 5 %");
   }
   return failed;
 }

@@ -3,7 +3,8 @@
 // manoeuvre through the whole harness. It fails when a run errs, a parameter with a truth is
 // missing, a value or std is not finite and positive, the HAC fit's value is not the estimate
 // table's (the same estimator on the same rows), an error exceeds 5 % (the trace smoke's bound
-// for these parameters with the car's noise), or the summary is not finite. Prints what it
+// for these parameters with the car's noise), the instrumental-variable fit is refused, not
+// finite and positive or off by more than 5 %, or the summary is not finite. Prints what it
 // measured; returns the number of failed checks.
 #include <filesystem>
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 namespace dynid::benchcoverage {
 namespace {
@@ -36,6 +37,27 @@ StdCoverage coverage_of(const std::vector<double>& errors, const std::vector<dou
   return c;
 }
 
+IvCoverage iv_of(const std::vector<const ParameterSample*>& samples) {
+  IvCoverage c;
+  std::vector<double> textbook, hac;
+  int rejections = 0;
+  for (const ParameterSample* s : samples) {
+    if (!s->iv_refused.empty()) ++c.refused;
+    if (!std::isfinite(s->iv_value) || !std::isfinite(s->iv_std) || !std::isfinite(s->iv_hac_std)) continue;
+    c.errors_pct.push_back(100.0 * s->iv_relative_error());
+    textbook.push_back(100.0 * s->iv_std / std::abs(s->truth));
+    hac.push_back(100.0 * s->iv_hac_std / std::abs(s->truth));
+    rejections += s->dwh_rejects ? 1 : 0;
+  }
+  c.seeds = static_cast<int>(c.errors_pct.size());
+  c.mean_error_pct = mean(c.errors_pct);
+  c.scatter_pct = scatter(c.errors_pct);
+  c.textbook = coverage_of(c.errors_pct, textbook);
+  c.hac = coverage_of(c.errors_pct, hac);
+  c.dwh_rejections = c.seeds > 0 ? static_cast<double>(rejections) / c.seeds : kNaN;
+  return c;
+}
+
 ParameterCoverage row_of(const std::vector<const ParameterSample*>& samples) {
   ParameterCoverage row;
   row.model = samples.front()->model;
@@ -54,6 +76,7 @@ ParameterCoverage row_of(const std::vector<const ParameterSample*>& samples) {
   row.scatter_pct = scatter(errors);
   row.table = coverage_of(errors, table);
   row.hac = coverage_of(errors, hac);
+  row.iv = iv_of(samples);
   return row;
 }
 
@@ -61,6 +84,30 @@ std::string cells(const StdCoverage& c) {
   char b[120];
   std::snprintf(b, sizeof b, " %.3g %% | %.0f %% | %.2f |", c.mean_std_pct, 100.0 * c.within_2std, c.error_over_std);
   return b;
+}
+
+// printf into a string (the cells of a table line).
+template <typename... Args>
+std::string formatted(const char* pattern, Args... args) {
+  char b[200];
+  std::snprintf(b, sizeof b, pattern, args...);
+  return b;
+}
+
+// A table line's first cells, "| model | parameter | ", then `pattern`.
+template <typename... Args>
+std::string start(const ParameterCoverage& r, const char* pattern, Args... args) {
+  return "| " + r.model + " | " + r.parameter + " | " + formatted(pattern, args...);
+}
+
+// A markdown table: the header line, its separator, one line per row.
+std::string table(const std::string& header, const std::vector<ParameterCoverage>& rows,
+                  const std::function<std::string(const ParameterCoverage&)>& line) {
+  std::string out = header + "\n";
+  for (std::size_t c = 1; c < static_cast<std::size_t>(std::count(header.begin(), header.end(), '|')); ++c) out += "|---";
+  out += "|\n";
+  for (const ParameterCoverage& r : rows) out += line(r) + "\n";
+  return out;
 }
 
 }  // namespace
@@ -83,17 +130,22 @@ std::vector<ParameterCoverage> summarize(const std::vector<SeedRun>& runs) {
 }
 
 std::string markdown_table(const std::vector<ParameterCoverage>& rows) {
-  std::string out =
-      "| model | parameter | truth | seeds | mean error | scatter | table std | within 2 table std | mean error / "
-      "table std | HAC std | within 2 HAC std | mean error / HAC std |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  for (const ParameterCoverage& r : rows) {
-    char b[200];
-    std::snprintf(b, sizeof b, "| %s | %s | %.6g | %d | %+.3g %% | %.3g %% |", r.model.c_str(), r.parameter.c_str(),
-                  r.truth, r.seeds, r.mean_error_pct, r.scatter_pct);
-    out += b + cells(r.table) + cells(r.hac) + "\n";
-  }
-  return out;
+  return table("| model | parameter | truth | seeds | mean error | scatter | table std | within 2 table std | mean error / "
+               "table std | HAC std | within 2 HAC std | mean error / HAC std |",
+               rows, [](const ParameterCoverage& r) {
+                 return start(r, "%.6g | %d | %+.3g %% | %.3g %% |", r.truth, r.seeds, r.mean_error_pct, r.scatter_pct) +
+                        cells(r.table) + cells(r.hac);
+               });
+}
+
+std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows) {
+  return table("| model | parameter | LS mean error | IV seeds | IV mean error | IV scatter | IV std | within 2 IV std | "
+               "mean error / IV std | IV HAC std | within 2 IV HAC std | mean error / IV HAC std | DWH rejects at 1 % |",
+               rows, [](const ParameterCoverage& r) {
+                 return start(r, "%+.3g %% | %d | %+.3g %% | %.3g %% |", r.mean_error_pct, r.iv.seeds,
+                              r.iv.mean_error_pct, r.iv.scatter_pct) +
+                        cells(r.iv.textbook) + cells(r.iv.hac) + formatted(" %.0f %% |", 100.0 * r.iv.dwh_rejections);
+               });
 }
 
 }  // namespace dynid::benchcoverage

@@ -17,6 +17,18 @@ struct StdCoverage {
   double error_over_std = kNaN;  ///< |mean error| / mean std: issue 16 asks <= 1/3
 };
 
+/// The instrumental-variable estimate (residual::iv_fit) over the same seeds.
+struct IvCoverage {
+  int seeds = 0;                 ///< seeds with a finite IV value and both of its std
+  int refused = 0;               ///< seeds where iv_fit refused (weak instruments, ...)
+  double mean_error_pct = kNaN;
+  double scatter_pct = kNaN;
+  std::vector<double> errors_pct;
+  StdCoverage textbook;          ///< s^2 (Z'W)^-1 Z'Z (W'Z)^-1
+  StdCoverage hac;               ///< the HAC sandwich
+  double dwh_rejections = kNaN;  ///< share of the seeds (IV estimated) where DWH rejects at 1 %
+};
+
 struct ParameterCoverage {
   std::string model;
   std::string parameter;
@@ -27,6 +39,7 @@ struct ParameterCoverage {
   std::vector<double> errors_pct;  ///< seed by seed
   StdCoverage table;             ///< the estimate table's std
   StdCoverage hac;               ///< the HAC std
+  IvCoverage iv;
 };
 
 /// One row per (model, parameter), in the order the runs first give them. A seed whose value or
@@ -35,5 +48,8 @@ std::vector<ParameterCoverage> summarize(const std::vector<SeedRun>& runs);
 
 /// The rows as a markdown table.
 std::string markdown_table(const std::vector<ParameterCoverage>& rows);
+
+/// The IV columns beside LS's mean error, as a markdown table.
+std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows);
 
 }  // namespace dynid::benchcoverage

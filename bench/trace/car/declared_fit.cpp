@@ -30,4 +30,14 @@ residual::ModelParameters declared_hac(const car::VehicleProfile& profile, const
                                   run.announcement.preprocessing.odmf);
 }
 
+residual::IvFit declared_iv(const car::VehicleProfile& profile, const std::string& model,
+                            const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments) {
+  const ingest::ModelSpec spec = model_spec(profile, model);
+  const auto m = model::make_model(spec.model, spec.constants);
+  residual::IvOptions options;
+  options.preprocessing = run.announcement.preprocessing;
+  return residual::iv_fit(*m, spec.effects, segments, run.announcement.sample_rate_hz,
+                          run.announcement.preprocessing.odmf, options);
+}
+
 }  // namespace dynid::benchcar

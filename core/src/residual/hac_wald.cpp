@@ -13,18 +13,14 @@
 namespace dynid::residual::detail {
 namespace {
 
-// Per grid index: the summed score u' e of every group's row there.
-struct TimeScores {
-  std::vector<Eigen::Index> grid;
-  std::vector<Eigen::VectorXd> score;
-};
-
+// Each row's weighted score u' e, in group order, with its grid index; `information` = sum u u'.
 TimeScores scores_by_time(const FoldedRows& rows, const Eigen::VectorXd& x, const std::vector<double>& weights,
                           const std::vector<Eigen::Index>& used, Eigen::MatrixXd& information) {
   const auto width = static_cast<Eigen::Index>(rows.parameters.size());
   const auto k = static_cast<Eigen::Index>(used.size());
   information = Eigen::MatrixXd::Zero(k, k);
-  std::map<Eigen::Index, Eigen::VectorXd> by_grid;
+  std::vector<Eigen::Index> grid;
+  std::vector<Eigen::VectorXd> scores;
   for (std::size_t g = 0; g < rows.collected.values.size(); ++g) {
     const std::vector<double>& v = rows.collected.values[g];
     const Eigen::Index m = static_cast<Eigen::Index>(v.size()) / (width + 1);
@@ -40,17 +36,13 @@ TimeScores scores_by_time(const FoldedRows& rows, const Eigen::VectorXd& x, cons
       }
       const double e = w * (all(i, width) - fitted);
       information.noalias() += u * u.transpose();
-      auto [it, fresh] = by_grid.try_emplace(rows.collected.grid_index[g][static_cast<std::size_t>(i)],
-                                             Eigen::VectorXd::Zero(k));
-      it->second += u * e;
+      grid.push_back(rows.collected.grid_index[g][static_cast<std::size_t>(i)]);
+      scores.push_back(u * e);
     }
   }
-  TimeScores out;
-  for (auto& [grid, value] : by_grid) {
-    out.grid.push_back(grid);
-    out.score.push_back(std::move(value));
-  }
-  return out;
+  Eigen::MatrixXd stacked(static_cast<Eigen::Index>(scores.size()), k);
+  for (std::size_t i = 0; i < scores.size(); ++i) stacked.row(static_cast<Eigen::Index>(i)) = scores[i].transpose();
+  return sum_by_grid(grid, stacked);
 }
 
 // Andrews and Monahan (1992): the scores are prewhitened by a VAR(1) fitted over pairs of rows
@@ -133,6 +125,28 @@ Eigen::MatrixXd newey_west(const TimeScores& t, int lags, int odmf) {
 
 }  // namespace
 
+TimeScores sum_by_grid(const std::vector<Eigen::Index>& grid, const Eigen::MatrixXd& scores) {
+  std::map<Eigen::Index, Eigen::VectorXd> by_grid;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    auto [it, fresh] = by_grid.try_emplace(grid[i], Eigen::VectorXd::Zero(scores.cols()));
+    it->second += scores.row(static_cast<Eigen::Index>(i)).transpose();
+  }
+  TimeScores out;
+  for (auto& [at, value] : by_grid) {
+    out.grid.push_back(at);
+    out.score.push_back(std::move(value));
+  }
+  return out;
+}
+
+Eigen::MatrixXd long_run_covariance(TimeScores t, int odmf, int& bandwidth) {
+  const Eigen::MatrixXd whitening = prewhiten(t, odmf);
+  bandwidth = andrews_bandwidth(t, odmf);
+  const Eigen::MatrixXd recolour =
+      (Eigen::MatrixXd::Identity(whitening.rows(), whitening.cols()) - whitening).completeOrthogonalDecomposition().pseudoInverse();
+  return recolour * newey_west(t, bandwidth, odmf) * recolour.transpose();
+}
+
 WaldTest hac_wald_test(const FoldedRows& rows, const Eigen::VectorXd& x, const std::vector<double>& weights,
                        Eigen::Index first, Eigen::Index end, int odmf) {
   WaldTest result;
@@ -149,12 +163,8 @@ WaldTest hac_wald_test(const FoldedRows& rows, const Eigen::VectorXd& x, const s
   if (tested.empty()) return result;
   result.degrees_of_freedom = static_cast<int>(tested.size());
   Eigen::MatrixXd information;
-  TimeScores t = scores_by_time(rows, x, weights, used, information);
-  const Eigen::MatrixXd whitening = prewhiten(t, odmf);
-  result.bandwidth = andrews_bandwidth(t, odmf);
-  const Eigen::MatrixXd recolour =
-      (Eigen::MatrixXd::Identity(whitening.rows(), whitening.cols()) - whitening).completeOrthogonalDecomposition().pseudoInverse();
-  const Eigen::MatrixXd meat = recolour * newey_west(t, result.bandwidth, odmf) * recolour.transpose();
+  const Eigen::MatrixXd meat =
+      long_run_covariance(scores_by_time(rows, x, weights, used, information), odmf, result.bandwidth);
   // The bread, inverted on unit-scaled columns: the columns' units differ by many orders (a
   // squared grade in rad^2 beside a force), and a rank threshold on the raw matrix would drop a
   // small but identifiable column and call its variance 0.

@@ -13,6 +13,7 @@
 // Scores of rows of different equation groups at one time (one grid index) are summed before
 // the lags are taken: the groups of one model see the same disturbances at the same instant.
 #include <cstdint>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -30,6 +31,20 @@ struct WaldTest {
   /// HAC standard deviation of every tested column, in column order (NaN: not identifiable).
   Eigen::VectorXd stds;
 };
+
+/// Scores summed per grid index (rows of several groups at one time add up), in grid order.
+struct TimeScores {
+  std::vector<Eigen::Index> grid;
+  std::vector<Eigen::VectorXd> score;
+};
+
+/// Row i's score is scores.row(i), at run grid index grid[i] (any order).
+TimeScores sum_by_grid(const std::vector<Eigen::Index>& grid, const Eigen::MatrixXd& scores);
+
+/// The long-run covariance sum_{l} E[s_t s_{t-l}'] of the scores, as the Wald test takes it:
+/// VAR(1) prewhitening, Newey-West with Andrews' bandwidth (returned in `bandwidth`, decimated
+/// rows), recoloured. `odmf`: grid steps between two rows.
+Eigen::MatrixXd long_run_covariance(TimeScores scores, int odmf, int& bandwidth);
 
 /// Tests columns [first, end) of `rows` (collected: fold_rows with collect) at the weighted
 /// solution `x` (NaN entries: not identifiable, left out of the covariance), each group's rows
