@@ -47,7 +47,8 @@ report::ExcitationReport excitation_of(const std::string& vehicle, const std::st
     const auto e = std::find_if(estimates.begin(), estimates.end(),
                                 [&](const ingest::ModelEstimate& m) { return m.model == table.model; });
     report::ModelExcitation m{table, {}};
-    for (const auto& p : e->parameters) m.excited_by.push_back(p.excited_by);
+    if (e != estimates.end())  // always: the tables are made from these estimates
+      for (const auto& p : e->parameters) m.excited_by.push_back(p.excited_by);
     out.models.push_back(std::move(m));
   }
   return out;

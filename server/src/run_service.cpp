@@ -448,17 +448,27 @@ void RunService::start_residual_job() {
     // Only the models this run excites: the loop's judgement of a model the run carries no
     // information about says nothing (and costs the most: every candidate is "significant").
     std::vector<std::string> models;
-    for (const dds::EstimateTable& t : tables_of(it->vehicle, it->run, run->processor.estimates()).tables)
-      if (t.not_excited.empty()) models.push_back(t.model);
-    std::vector<ingest::Chunk> chunks;  // read here: the store is this worker's to read
-    replay_stored(*it, *run, [&](const ingest::Chunk& chunk) { chunks.push_back(chunk); });
+    std::vector<ingest::Chunk> chunks;
     run->residual_at = now;
-    residual_job_.emplace(ResidualJob{
-        *it, run->contiguous,
-        std::async(std::launch::async,
-                   [announcement = run->processor.announcement(), chunks = std::move(chunks), models = std::move(models)] {
-                     return live_verdicts(announcement, chunks, models);
-                   })});
+    try {
+      for (const dds::EstimateTable& t : tables_of(it->vehicle, it->run, run->processor.estimates()).tables)
+        if (t.not_excited.empty()) models.push_back(t.model);
+      // Read here: the store is this worker's to read.
+      replay_stored(*it, *run, [&](const ingest::Chunk& chunk) { chunks.push_back(chunk); });
+      residual_job_.emplace(ResidualJob{
+          *it, run->contiguous,
+          std::async(std::launch::async,
+                     [announcement = run->processor.announcement(), chunks = std::move(chunks), models = std::move(models)] {
+                       return live_verdicts(announcement, chunks, models);
+                     })});
+    } catch (const std::exception& e) {
+      // A stored chunk that cannot be read back, or no thread to be had: no verdict, and the
+      // worker's tick (or the publication that called it) goes on; tried again when the run is
+      // published again.
+      spdlog::warn("run {}: no live residual verdict: {}", label(*it), e.what());
+      it = residual_stale_.erase(it);
+      continue;
+    }
     residual_stale_.erase(it);
     return;
   }
