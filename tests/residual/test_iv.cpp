@@ -127,6 +127,7 @@ struct Tally {
   int rejections = 0;
   int rejections_at_10 = 0;  // at 10 %: the level is read better there
   int within_2std = 0;
+  int scale_apart = 0;  // seeds where |IV - LS| of the scale exceeds 2 of its difference_std
 };
 
 Tally over_seeds(int seeds, double vx_noise, double ax_noise) {
@@ -147,6 +148,7 @@ Tally over_seeds(int seeds, double vx_noise, double ax_noise) {
     t.iv_hac_std += iv.hac_std(0);
     t.rejections += iv.dwh.rejects ? 1 : 0;
     t.within_2std += std::abs(iv.value(0) - kScale) <= 2.0 * iv.hac_std(0) ? 1 : 0;
+    t.scale_apart += std::abs(iv.value(0) - iv.ls_value(0)) > 2.0 * iv.difference_std(0) ? 1 : 0;
   }
   const double n = std::max(1, t.seeds);
   t.ls_error /= n, t.iv_error /= n, t.iv_std /= n, t.iv_hac_std /= n, t.ls_std /= n;
@@ -170,6 +172,7 @@ TEST(IvFit, NoiseInTheDifferentiatedChannelBiasesLeastSquaresNotIv) {
   EXPECT_LT(std::abs(t.iv_error), t.iv_hac_std);
   EXPECT_LT(std::abs(t.iv_error), std::abs(t.ls_error) / 5.0);
   EXPECT_GE(t.within_2std, kSeeds - 2);
+  EXPECT_GE(t.scale_apart, kSeeds - 2) << "the parameter the noise biases is named";
 }
 
 // (c) Noise on the measured side only: LS is unbiased, DWH rejects at about its 1 % level (at
@@ -180,6 +183,8 @@ TEST(IvFit, WithoutRegressorNoiseTheHausmanTestHoldsItsLevel) {
   ASSERT_EQ(t.seeds, kSeeds);
   EXPECT_LE(t.rejections, 3);
   EXPECT_LT(std::abs(t.iv_error), t.iv_hac_std);
+  // Each seed's |IV - LS| > 2 difference_std at about 5 %: 6 or more of 40 has probability 1 %.
+  EXPECT_LE(t.scale_apart, 5);
 }
 
 // A regressor that is noise only (constant speed but for the sensor's noise): the lagged rows

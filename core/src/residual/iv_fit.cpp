@@ -157,6 +157,7 @@ Eigen::MatrixXd long_run(const Stacked& s, const Eigen::MatrixXd& scores, int od
 DurbinWuHausman hausman(const Eigen::VectorXd& d, const Eigen::MatrixXd& v, int bandwidth, double level) {
   DurbinWuHausman out;
   out.bandwidth = bandwidth;
+  out.level = level;
   const Eigen::VectorXd c = v.diagonal().cwiseMax(std::numeric_limits<double>::min()).cwiseSqrt().cwiseInverse();
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(c.asDiagonal() * v * c.asDiagonal(), Eigen::ComputeFullU);
   const Eigen::VectorXd projected = svd.matrixU().transpose() * c.asDiagonal() * d;
@@ -209,6 +210,7 @@ void estimate(const Stacked& s, const Eigen::MatrixXd& qz, const Eigen::VectorXd
   fit.ls_value = unscaled(ls, scale, used, width);
   fit.std = unscaled(textbook.diagonal().cwiseMax(0.0).cwiseSqrt(), scale, used, width);
   fit.hac_std = unscaled(hac.diagonal().cwiseMax(0.0).cwiseSqrt(), scale, used, width);
+  fit.difference_std = unscaled(v_d.diagonal().cwiseMax(0.0).cwiseSqrt(), scale, used, width);
   fit.dwh = hausman(iv - ls, v_d, bandwidth, options.level);
 }
 
@@ -227,7 +229,7 @@ void refuse(IvFit& fit, const std::string& reason) {
   fit.refused = true;
   fit.reason = reason;
   const auto width = static_cast<Eigen::Index>(fit.parameters.size());
-  fit.value = fit.std = fit.hac_std = fit.ls_value = Eigen::VectorXd::Constant(width, kNaN);
+  fit.value = fit.std = fit.hac_std = fit.ls_value = fit.difference_std = Eigen::VectorXd::Constant(width, kNaN);
 }
 
 // Unit column norms of W: the solves and the rank and strength checks then do not depend on the
@@ -254,6 +256,18 @@ std::string unusable(const Stacked& s, const Eigen::VectorXd& scale, const std::
 }
 
 }  // namespace
+
+std::string IvFit::statement() const {
+  if (refused) return "instrumental variables refused (" + reason + "): the least-squares values are not tested for bias";
+  char figures[160];
+  std::snprintf(figures, sizeof figures, "Durbin-Wu-Hausman p = %.2g %s %g, %d dof", dwh.p_value,
+                dwh.rejects ? "<" : ">=", dwh.level, dwh.degrees_of_freedom);
+  if (dwh.rejects)
+    return std::string("least squares is biased by noise in the regressors (") + figures +
+           "): the instrumental-variable values are the estimate";
+  return std::string("no evidence that noise in the regressors biases least squares (") + figures +
+         "): the least-squares values stand";
+}
 
 int instrument_lag(const ingest::Preprocessing& preprocessing, double sample_rate_hz, double bound) {
   const signal::Sos sos = signal::butterworth_lowpass(preprocessing.butterworth_order,

@@ -95,7 +95,8 @@ struct DurbinWuHausman {
   int degrees_of_freedom = 0;
   double p_value = 1.0;
   int bandwidth = 0;       ///< Newey-West lags of V_d, decimated rows
-  bool rejects = false;    ///< p_value < IvOptions::level: LS is biased on these rows
+  double level = 0.01;     ///< IvOptions::level
+  bool rejects = false;    ///< p_value < level: LS is biased on these rows
 };
 
 struct IvFit {
@@ -115,7 +116,16 @@ struct IvFit {
   Eigen::VectorXd std;        ///< textbook
   Eigen::VectorXd hac_std;    ///< HAC sandwich
   Eigen::VectorXd ls_value;   ///< weighted LS on the same rows
+  /// HAC std of value - ls_value (the square root of V_d's diagonal): per parameter, how far
+  /// apart the two may lie by chance under DWH's null; NaN where LS identifies nothing.
+  Eigen::VectorXd difference_std;
   DurbinWuHausman dwh;
+
+  /// True when the IV values are the ones to use: IV estimated and DWH rejects least squares.
+  bool replaces_least_squares() const { return !refused && dwh.rejects; }
+  /// One line an engineer reads: LS biased (use IV), no evidence of bias (LS stands), or why IV
+  /// was refused; with the test's figures.
+  std::string statement() const;
 };
 
 /// The lag rule above, in decimated rows (>= 1), for a run at `sample_rate_hz` preprocessed by
