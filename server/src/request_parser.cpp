@@ -31,6 +31,7 @@ const std::map<std::string, KindSpec>& kinds() {
       {"add-effect", {{"vehicle", "run", "model", "effect"}, {"effects", "reference", "format"}, {"reference"}}},
       {"trace", {{"vehicle", "run", "model"}, {"effects", "reference", "rounds", "format"}, {"reference"}}},
       {"consistency", {{"vehicle", "run"}, {"reference", "format"}, {"reference"}}},
+      {"iv", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},
       {"status", {{}, {"format"}, {}}},
       {"fleet", {{"model", "shared", "vehicles"}, {"format"}, {"shared"}}},
   };

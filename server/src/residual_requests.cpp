@@ -5,6 +5,7 @@
 #include "dynid/error.hpp"
 #include "dynid/ingest/recorded_run.hpp"
 #include "dynid/model/registry.hpp"
+#include "dynid/report/iv_report.hpp"
 #include "dynid/report/residual_html.hpp"
 #include "dynid/report/residual_report.hpp"
 #include "dynid/residual/effect_comparison.hpp"
@@ -76,8 +77,8 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
     throw InputError("residual report: format '" + request.format + "' (text, json or html)");
   if (request.rounds < 0 || request.rounds > 10)
     throw InputError("trace: rounds " + std::to_string(request.rounds) + " (0 to 10)");
-  if (request.kind == "consistency" && request.format == "html")
-    throw InputError("consistency report: format 'html' (text or json)");
+  if ((request.kind == "consistency" || request.kind == "iv") && request.format == "html")
+    throw InputError(request.kind + " report: format 'html' (text or json)");
   const ingest::RecordedRun run = ingest::assemble_run(announcement, chunks);
   const auto segments = ingest::preprocess_offline(run);
   if (segments.empty())
@@ -89,6 +90,11 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
   const double rate = announcement.sample_rate_hz;
   const int odmf = announcement.preprocessing.odmf;
   const std::string title = announcement.vehicle + " / " + announcement.run + " / " + spec.model;
+  if (request.kind == "iv") {
+    const residual::IvFit fit = iv_of(*model, declared, announcement, segments);
+    if (request.format == "json") return {report::iv_json(fit), "application/json"};
+    return {report::format_iv_text(fit), "text/plain"};
+  }
   if (request.kind == "trace") {
     residual::TraceOptions options;
     options.max_rounds = request.rounds;
@@ -109,6 +115,15 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
   return {report::format_comparison_text(cmp), "text/plain"};
 }
 
+residual::IvFit iv_of(const model::Model& model, const std::vector<std::string>& effects,
+                      const ingest::RunAnnouncement& announcement,
+                      const std::vector<ingest::PreprocessedSegment>& segments) {
+  residual::IvOptions options;
+  options.preprocessing = announcement.preprocessing;
+  return residual::iv_fit(model, effects, segments, announcement.sample_rate_hz, announcement.preprocessing.odmf,
+                          options);
+}
+
 std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& announcement,
                                                  const std::vector<ingest::Chunk>& chunks,
                                                  const std::vector<std::string>& models) {
@@ -120,15 +135,27 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
   options.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
   for (const ingest::ModelSpec& spec : announcement.models) {
     if (std::find(models.begin(), models.end(), spec.model) == models.end()) continue;
+    LiveVerdict verdict;
+    std::unique_ptr<model::Model> model;
     try {
-      const auto model = model::make_model(spec.model, spec.constants);
+      model = model::make_model(spec.model, spec.constants);
+    } catch (const InputError&) {
+      continue;  // the server folds no such model either
+    }
+    try {
       const residual::Diagnosis d = residual::diagnose(*model, spec.effects, run, segments, options);
       const bool measured = std::all_of(d.floor.groups.begin(), d.floor.groups.end(),
                                         [](const residual::GroupFloor& g) { return g.rows == 0 || g.floor_rms > 0.0; });
-      if (measured) out[spec.model] = {residual::verdict_name(d.verdict), d.statement()};
+      if (measured) verdict.verdict = residual::verdict_name(d.verdict), verdict.statement = d.statement();
     } catch (const InputError&) {
       // Not diagnosable yet (no row of this model so far): no verdict rather than a wrong one.
     }
+    try {
+      verdict.iv = iv_of(*model, spec.effects, announcement, segments);
+    } catch (const InputError&) {
+      // No row yet: no IV estimate (a refusal for weak instruments is a result, not this).
+    }
+    if (!verdict.verdict.empty() || verdict.iv) out[spec.model] = std::move(verdict);
   }
   return out;
 }

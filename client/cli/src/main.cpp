@@ -183,7 +183,7 @@ int main(int argc, char** argv) {
                  "Cyclone DDS configuration: file, file:// URI or XML (or $DYNID_CYCLONE_CONFIG)");
   app.add_option("--domain", c.domain, "DDS domain id")->check(dynid::input::within(0, 230));
   auto* timeout = app.add_option("--timeout", c.timeout_s,
-                                 "seconds to wait for the server (default 10; 120 for residual, add-effect, trace)")
+                                 "seconds to wait for the server (default 10; 120 for residual, add-effect, trace, consistency, iv)")
                       ->check(dynid::input::within(kMinSeconds, kMaxSeconds));
   app.add_flag("--json", c.json, "JSON instead of text");
 
@@ -253,6 +253,13 @@ int main(int argc, char** argv) {
   consistency_cmd->add_option("--vehicle", vehicle)->required();
   consistency_cmd->add_option("--run", run)->required();
   consistency_cmd->add_option("--reference", references, "a known value, name=value (repeat), e.g. mass=1457.5");
+  auto* iv_cmd = app.add_subcommand(
+      "iv", "is least squares biased by noisy regressors? the instrumental-variable estimate and the "
+            "Durbin-Wu-Hausman test (docs/ACCURACY.md)");
+  iv_cmd->add_option("--vehicle", vehicle)->required();
+  iv_cmd->add_option("--run", run)->required();
+  iv_cmd->add_option("--model", model)->required();
+  iv_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's; none: no effect)");
   auto* base_cmd = app.add_subcommand("base", "base-parameter report of a run's model");
   base_cmd->add_option("--vehicle", vehicle)->required();
   base_cmd->add_option("--run", run)->required();
@@ -316,6 +323,10 @@ int main(int argc, char** argv) {
       auto a = args({{"vehicle", vehicle}, {"run", run}});
       for (const auto& r : references) a.push_back({"reference", r});
       return request(c, "consistency", a);
+    }
+    if (*iv_cmd) {
+      if (timeout->count() == 0) c.timeout_s = 120.0;  // the run replayed and assembled
+      return request(c, "iv", args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects}}));
     }
     if (*base_cmd) return request(c, "base", args({{"vehicle", vehicle}, {"run", run}, {"model", model}}));
     if (*close_cmd) return request(c, "close", args({{"vehicle", vehicle}, {"run", run}}));

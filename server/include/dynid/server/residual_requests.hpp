@@ -11,12 +11,16 @@
 //                                                                     shared parameters and
 //                                                                     references compared
 //                                                                     (consistency.hpp)
+//   iv          vehicle*, run*, model*, effects, format                instrumental variables and
+//                                                                     the Durbin-Wu-Hausman test
+//                                                                     (iv_fit.hpp)
 //
 // `effects` (comma list) are the model's declared effects; absent, those the run's announcement
 // gives the model; "none", no effect. `candidates` (comma list) restricts the screen. `reference` (repeatable,
 // name=value, e.g. mass=1457.5): known values, whose errors the trace reports. `rounds`: effects
 // the trace may add (0..10, default 4). format: text (default), json (for tools), or html (the
-// self-contained page of report/residual_html.hpp; a trace's page shows its last added effect).
+// self-contained page of report/residual_html.hpp; a trace's page shows its last added effect;
+// not for consistency and iv).
 //
 // The run is replayed from the store (every chunk up to the highest contiguous one), assembled
 // and preprocessed offline (ingest/recorded_run.hpp). Pure: no DDS, no store; RunService feeds
@@ -28,7 +32,10 @@
 #include <vector>
 
 #include "dynid/ingest/chunk.hpp"
+#include "dynid/ingest/recorded_run.hpp"
 #include "dynid/ingest/run_announcement.hpp"
+#include "dynid/model/model.hpp"
+#include "dynid/residual/iv_fit.hpp"
 
 namespace dynid::server {
 
@@ -38,7 +45,7 @@ struct ResidualRequest {
   std::vector<std::string> candidates;              ///< empty: every candidate
   std::string effect;                               ///< add-effect only
   std::string format = "text";                      ///< text | json | html
-  std::string kind = "residual";                    ///< residual | add-effect | trace | consistency
+  std::string kind = "residual";                    ///< residual | add-effect | trace | consistency | iv
   std::map<std::string, double> reference;          ///< add-effect, trace, consistency
   int rounds = 4;                                   ///< trace only
 };
@@ -51,16 +58,25 @@ struct ResidualReply {
 ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
                              const std::vector<ingest::Chunk>& chunks, const ResidualRequest& request);
 
-/// The residual loop's verdict on one model of a run (residual::Diagnosis, one line).
+/// What the server judges of one model of a run in the background (--live-residual): the residual
+/// loop's verdict (residual::Diagnosis, one line) and the instrumental-variable estimate with its
+/// test of least squares' bias (residual::IvFit), each absent when it cannot be had yet.
 struct LiveVerdict {
-  std::string verdict;    ///< "adequate", "explained", "structure left"
+  std::string verdict;    ///< "adequate", "explained", "structure left"; "" when not diagnosed
   std::string statement;  ///< Diagnosis::statement()
+  std::optional<residual::IvFit> iv;
 };
+
+/// The instrumental-variable fit of a model on a run, as the `iv` request and the live
+/// judgement take it: the run's preprocessing sets the instruments' lag.
+residual::IvFit iv_of(const model::Model& model, const std::vector<std::string>& effects,
+                      const ingest::RunAnnouncement& announcement,
+                      const std::vector<ingest::PreprocessedSegment>& segments);
 
 /// The verdict of each of `models` (announced models, with their declared effects) on the run so
 /// far: what a server started with --live-residual publishes beside the estimates. A model that
-/// cannot be diagnosed yet (no row, no valid segment long enough to filter, a noise floor that
-/// cannot be measured on so little) is left out, not an error.
+/// can be neither diagnosed nor fitted by IV yet (no row, no valid segment long enough to filter,
+/// a noise floor that cannot be measured on so little) is left out, not an error.
 std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& announcement,
                                                  const std::vector<ingest::Chunk>& chunks,
                                                  const std::vector<std::string>& models);
