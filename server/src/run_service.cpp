@@ -418,8 +418,9 @@ void RunService::publish(const store::RunKey& key, RunState& run) {
   dirty_.erase(key);
   run.last_published = std::chrono::steady_clock::now();
   refresh_residual(key, run);
-  EstimateTables tables = tables_of(key.vehicle, key.run, run.processor.estimates());
-  attach_residual(run, tables);
+  const auto estimates = run.processor.estimates();
+  EstimateTables tables = tables_of(key.vehicle, key.run, estimates);
+  attach_live(run, estimates, tables);
   publish_tables(key.vehicle, std::move(tables));
 }
 
@@ -494,13 +495,23 @@ void RunService::collect_residual_job() {
   start_residual_job();
 }
 
-void RunService::attach_residual(const RunState& run, EstimateTables& tables) {
+void RunService::attach_live(const RunState& run, const std::vector<ingest::ModelEstimate>& estimates,
+                             EstimateTables& tables) {
   for (dds::EstimateTable& table : tables.tables) {
     const auto it = run.residual.find(table.model);
     if (it == run.residual.end()) continue;
-    table.residual_verdict = it->second.verdict;
-    table.residual_statement = it->second.statement;
-    table.residual_through = static_cast<std::uint64_t>(run.residual_through);
+    const LiveVerdict& live = it->second;
+    const auto through = static_cast<std::uint64_t>(run.residual_through);
+    if (!live.verdict.empty()) {
+      table.residual_verdict = live.verdict;
+      table.residual_statement = live.statement;
+      table.residual_through = through;
+    }
+    if (!live.iv) continue;
+    const auto estimate = std::find_if(estimates.begin(), estimates.end(),
+                                       [&](const ingest::ModelEstimate& e) { return e.model == table.model; });
+    if (estimate != estimates.end() && estimate->estimate)
+      apply_iv(table, estimate->parameters, *estimate->estimate, *live.iv, through);
   }
 }
 

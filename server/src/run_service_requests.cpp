@@ -90,8 +90,9 @@ EstimateTables RunService::estimate(const std::string& vehicle,
   const store::RunKey key{vehicle, run ? *run : latest_run(vehicle)};
   RunState& state = load(key);
   refresh_residual(key, state);  // a new verdict comes with a later publication
-  auto tables = tables_of(vehicle, key.run, state.processor.estimates(), model);
-  attach_residual(state, tables);
+  const auto estimates = state.processor.estimates();
+  auto tables = tables_of(vehicle, key.run, estimates, model);
+  attach_live(state, estimates, tables);
   if (model && tables.tables.empty() && tables.notes.empty())
     throw NotFound("run " + vehicle + "/" + key.run + " has no model " + *model);
   if (!state.halted.empty()) tables.notes.push_back(key.run + ": " + state.halted);
@@ -171,8 +172,9 @@ EstimateTables RunService::close(const std::string& vehicle, const std::string& 
   if (!state.processor.finished()) state.processor.finish();  // folds the held-back samples
   context_.store.with([&](store::Store& s) { s.close_run(key); });
   publish(key, state);  // and the finished run's live verdict, once diagnosed
-  auto tables = tables_of(vehicle, run, state.processor.estimates());
-  attach_residual(state, tables);
+  const auto estimates = state.processor.estimates();
+  auto tables = tables_of(vehicle, run, estimates);
+  attach_live(state, estimates, tables);
   record_history(key, tables);
   spdlog::info("run {}/{}: closed", vehicle, run);
   return tables;

@@ -2,6 +2,7 @@
 // that joins late gets exactly the latest sample of every key, and keys do not mix.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <thread>
 
@@ -154,6 +155,34 @@ TEST(DdsState, ParameterStatusesReasonsAndTheModelNoteCrossTheWire) {
   t.parameters[0].status = ls::ParameterStatus::kRegrouped;
   EXPECT_EQ(to_wire(t).data.parameters._buffer[0].verdict, dynid_wire_NO_VERDICT);
   EXPECT_THROW(apply_verdict(t, model::ModelVerdict{}), InputError);
+}
+
+TEST(DdsState, TheEstimatorAndTheLeastSquaresValuesItReplacesCrossTheWire) {
+  // Issue 16: where the bias test rejects least squares the rows carry IV's values and the
+  // least-squares ones beside them; the table says whose values they are and why.
+  EstimateTable t = table("A", "lateral_bicycle", 1, 3162.0);
+  t.estimator = kInstrumentalVariables;
+  t.bias_test = "least squares is biased by noise in the regressors (Durbin-Wu-Hausman p = 1e-06 < 0.01, 3 dof)";
+  t.bias_through = 41;
+  t.parameters[0].least_squares_value = 3101.5;
+  t.parameters[0].least_squares_std = 4.25;
+  auto back = from_wire(to_wire(t).data);
+  EXPECT_EQ(back.estimator, kInstrumentalVariables);
+  EXPECT_EQ(back.bias_test, t.bias_test);
+  EXPECT_EQ(back.bias_through, 41u);
+  EXPECT_EQ(back.parameters[0].value, 3162.0);
+  EXPECT_EQ(back.parameters[0].least_squares_value, 3101.5);
+  EXPECT_EQ(back.parameters[0].least_squares_std, 4.25);
+  // An older server sends no estimator and zeros in the new members: least squares, and no
+  // least-squares value that would read as a replaced one.
+  auto older = to_wire(t);
+  older.data.estimator[0] = '\0';
+  older.data.parameters._buffer[0].least_squares_value = 0.0;
+  older.data.parameters._buffer[0].least_squares_std = 0.0;
+  back = from_wire(older.data);
+  EXPECT_EQ(back.estimator, kLeastSquares);
+  EXPECT_TRUE(std::isnan(back.parameters[0].least_squares_value));
+  EXPECT_TRUE(std::isnan(back.parameters[0].least_squares_std));
 }
 
 }  // namespace

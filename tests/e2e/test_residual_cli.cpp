@@ -195,6 +195,93 @@ TEST(E2eResidualCli, TheLiveVerdictIsPublishedBesideTheEstimates) {
   ASSERT_NE(it, published.end()) << watcher.seen();
   EXPECT_EQ(it->second.residual_verdict, table["residual_verdict"].get<std::string>());
   EXPECT_EQ(it->second.residual_through, last);
+  // The bias test runs beside it, and the table's values are the estimator it chooses. (Even
+  // this quiet speed biases least squares measurably on so precise a run: sensor_scale -0.06 %,
+  // 1.2 of its std; the next test holds the values themselves.)
+  const std::string bias_test = table["bias_test"].get<std::string>();
+  ASSERT_FALSE(bias_test.empty()) << table.dump();
+  EXPECT_EQ(table["estimator"], bias_test.rfind("least squares is biased", 0) == 0 ? "instrumental variables"
+                                                                                   : "least squares")
+      << bias_test;
+}
+
+// Issue 16 item 2: a run whose speed sensor is noisy biases least squares (the differentiated
+// speed is a regressor). The live bias test (Durbin-Wu-Hausman) rejects it, and the tables carry
+// the instrumental-variable values with their HAC std, the least-squares ones beside them: the
+// values `dynid iv` gives on the stored run, in the reply and on the topic.
+TEST(E2eResidualCli, WhereTheBiasTestRejectsLeastSquaresTheTablesCarryTheIvValues) {
+  TempDir dir;
+  server::ServerOptions options = server_options(dir.file("store.db"));
+  options.live_residual_interval = std::chrono::seconds(1);
+  InProcessServer server(options);
+  ingest::test::Truth truth;
+  truth.vx_noise = 0.15;
+  const auto run = test_run("iv-car", "run-i", 53u, truth);
+  const auto chunks = cut_run(run, 6u);
+  EstimateWatcher watcher("iv-car");
+  TestCar car("iv-car");
+  ASSERT_TRUE(car.stream(run.announcement, chunks));
+  ASSERT_EQ(dynid({"close", "--vehicle", "iv-car", "--run", "run-i"}).exit_code, 0);
+
+  const std::vector<std::string> where{"--vehicle", "iv-car", "--run", "run-i", "--model", "kinematic_longitudinal"};
+  std::vector<std::string> args{"--json", "iv"};
+  args.insert(args.end(), where.begin(), where.end());
+  const auto direct = dynid(args);
+  ASSERT_EQ(direct.exit_code, 0) << direct.err;
+  const auto iv = nlohmann::json::parse(direct.out);
+  ASSERT_TRUE(iv["replaces_least_squares"].get<bool>()) << "the run must bias least squares for the test to mean "
+                                                          << "anything:\n" << iv.dump(1);
+  const std::uint64_t last = chunks.back().sequence;
+  nlohmann::json table;
+  for (int attempt = 0; attempt < 120 && table.is_null(); ++attempt) {
+    args = {"--json", "estimates"};
+    args.insert(args.end(), where.begin(), where.end());
+    const auto reply = dynid(args);
+    ASSERT_EQ(reply.exit_code, 0) << reply.err;
+    const auto t = nlohmann::json::parse(reply.out)["tables"][0];
+    if (t["bias_through"] == last && t["estimator"] == "instrumental variables") table = t;
+    else std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+  ASSERT_FALSE(table.is_null()) << "no IV values through chunk #" << last;
+  EXPECT_EQ(table["bias_test"], iv["statement"]);
+  const auto& sensor_scale = table["parameters"][0];
+  ASSERT_EQ(sensor_scale["name"], "sensor_scale");
+  EXPECT_EQ(sensor_scale["value"], iv["parameters"][0]["iv"]);  // the same stored chunks, the same fit
+  EXPECT_EQ(sensor_scale["std"], iv["parameters"][0]["iv_hac_std"]);
+  // The least-squares value is the fold's (all rows), attenuated: below IV, and below the truth.
+  const double ls = sensor_scale["least_squares_value"].get<double>();
+  EXPECT_LT(ls, sensor_scale["value"].get<double>());
+  EXPECT_LT(ls, truth.scale);
+  EXPECT_LT(std::abs(sensor_scale["value"].get<double>() - truth.scale),
+            3.0 * sensor_scale["std"].get<double>());
+
+  args = {"estimates"};
+  args.insert(args.end(), where.begin(), where.end());
+  const auto text = dynid(args).out;
+  for (const std::string word : {"values by instrumental variables", "(least squares ", "bias test (chunks through #"})
+    EXPECT_NE(text.find(word), std::string::npos) << "missing '" << word << "' in\n" << text;
+  args = {"iv"};
+  args.insert(args.end(), where.begin(), where.end());
+  const auto iv_text = dynid(args).out;
+  for (const std::string word : {"least squares", "IV std HAC", "Durbin-Wu-Hausman", "verdict: least squares is biased"})
+    EXPECT_NE(iv_text.find(word), std::string::npos) << "missing '" << word << "' in\n" << iv_text;
+
+  watcher.wait_for({}, "run-i", std::chrono::milliseconds(3000));  // nothing to match: reads for 3 s
+  const auto& published = watcher.latest("run-i");
+  const auto it = published.find("kinematic_longitudinal");
+  ASSERT_NE(it, published.end()) << watcher.seen();
+  EXPECT_EQ(it->second.estimator, dds::kInstrumentalVariables);
+  EXPECT_EQ(it->second.parameters[0].value, sensor_scale["value"].get<double>());
+  EXPECT_EQ(it->second.parameters[0].least_squares_value, ls);
+
+  // Bad requests are named: a model the run has not, html.
+  args = {"iv", "--vehicle", "iv-car", "--run", "run-i", "--model", "suspension_fl"};
+  const auto no_model = dynid(args);
+  EXPECT_EQ(no_model.exit_code, 2);
+  EXPECT_NE(no_model.err.find("has no model 'suspension_fl'"), std::string::npos) << no_model.err;
+  const auto html = request("iv", {{"vehicle", "iv-car"}, {"run", "run-i"}, {"model", "kinematic_longitudinal"},
+                                   {"format", "html"}});
+  EXPECT_EQ(html.status, dds::ReplyStatus::kBadRequest);
 }
 
 }  // namespace

@@ -26,6 +26,7 @@ struct Truth {
   double scale = 1.0, offset = 0.12;                           // kinematic
   double inertia = 0.9, p = 12.0, q = 0.05, r = 4e-4;          // driveline (gear 3)
   double wheel_radius = 0.31, air_density = 1.2, ratio = 3.9;  // constants
+  double vx_noise = 0.01;  // the speed sensor's noise std (m/s): what d_vx's noise grows from
 };
 
 struct TestRun {
@@ -68,7 +69,7 @@ inline TestRun make_run(Eigen::Index n = 6000, unsigned seed = 1u, const Truth& 
     const double w = t.ratio * vx / t.wheel_radius;
     const double dw = t.ratio * dvx / t.wheel_radius;
     const bool second = k >= 4100 && k < 4400;
-    run.samples(k, 0) = vx + 0.01 * noise(rng);
+    run.samples(k, 0) = vx + t.vx_noise * noise(rng);
     run.samples(k, 1) = t.scale * dvx + t.offset + 0.05 * noise(rng);
     run.samples(k, 2) = t.wheel_radius * force + 5.0 * noise(rng);
     run.samples(k, 3) = w + 0.05 * noise(rng);

@@ -60,6 +60,9 @@ std::string WatchView::text(const dds::EstimateTable& t) {
   if (!t.not_excited.empty()) return out + "  not excited by this run: " + t.not_excited + "\n";
   if (!t.residual_verdict.empty())
     out += fmt::format("  residual (chunks through #{}): {}\n", t.residual_through, t.residual_verdict);
+  if (t.estimator != dds::kLeastSquares)
+    out += fmt::format("  values by {} (chunks through #{}): least squares is biased on this run\n", t.estimator,
+                       t.bias_through);
   out += fmt::format("  {:<26} {:>12} {:>11} {:>8}  {:<17}  {}\n", "parameter", "value", "std",
                      "rel.std%", "status", "moved since last");
   for (const auto& p : t.parameters)
@@ -96,10 +99,10 @@ std::string WatchView::json_line(const dds::EstimateTable& t) {
   return fmt::format(
       "{{\"vehicle\":{},\"model\":{},\"source\":{},\"revision\":{},\"rows\":{},"
       "\"not_excited\":{},\"residual_verdict\":{},\"residual_statement\":{},\"residual_through\":{},"
-      "\"parameters\":[{}]}}\n",
+      "\"estimator\":{},\"bias_test\":{},\"bias_through\":{},\"parameters\":[{}]}}\n",
       json_string(t.vehicle), json_string(t.model), json_string(t.source), t.revision, t.rows,
       json_string(t.not_excited), json_string(t.residual_verdict), json_string(t.residual_statement),
-      t.residual_through, parameters);
+      t.residual_through, json_string(t.estimator), json_string(t.bias_test), t.bias_through, parameters);
 }
 
 }  // namespace dynid::cli

@@ -1,5 +1,6 @@
 // Conversions of the state and request topics: ChunkAck, Estimate, Request, Reply.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -8,6 +9,8 @@
 #include <utility>
 
 #include "dynid/dds/conversions.hpp"
+
+#include <cmath>
 #include "wire_fields.hpp"
 
 namespace dynid::dds {
@@ -98,6 +101,8 @@ void put_parameter(dynid_wire_ParameterRow& out, const ParameterEntry& entry,
   std::tie(out.status, out.verdict) = to_wire_status(entry.status);
   put_text(out.relation, entry.relation);
   put_text(out.reason, entry.reason);
+  out.least_squares_value = entry.least_squares_value;
+  out.least_squares_std = entry.least_squares_std;
 }
 
 ParameterEntry get_parameter(const dynid_wire_ParameterRow& in, const std::string& where) {
@@ -112,6 +117,8 @@ ParameterEntry get_parameter(const dynid_wire_ParameterRow& in, const std::strin
                                    wire_enum_value(in.verdict), at);
   entry.relation = get(in.relation, at + " relation");
   entry.reason = get(in.reason, at + " reason");
+  entry.least_squares_value = in.least_squares_value;  // meaningful under IV only: from_wire
+  entry.least_squares_std = in.least_squares_std;
   return entry;
 }
 
@@ -178,6 +185,9 @@ Sample<dynid_wire_Estimate> to_wire(const EstimateTable& table) {
   put_id(out.residual_verdict, table.residual_verdict, where + " residual_verdict");
   put_text(out.residual_statement, table.residual_statement);
   out.residual_through = table.residual_through;
+  put_id(out.estimator, table.estimator, where + " estimator");
+  put_text(out.bias_test, table.bias_test);
+  out.bias_through = table.bias_through;
   return sample;
 }
 
@@ -202,6 +212,12 @@ EstimateTable from_wire(const dynid_wire_Estimate& sample) {
   table.residual_verdict = get(sample.residual_verdict, where + " residual_verdict");
   table.residual_statement = get(sample.residual_statement, where + " residual_statement");
   table.residual_through = sample.residual_through;
+  table.estimator = get(sample.estimator, where + " estimator");
+  if (table.estimator.empty()) table.estimator = kLeastSquares;  // an older server's
+  if (table.estimator != kInstrumentalVariables)  // an older server sends zeros there
+    for (ParameterEntry& p : table.parameters) p.least_squares_value = p.least_squares_std = std::nan("");
+  table.bias_test = get(sample.bias_test, where + " bias_test");
+  table.bias_through = sample.bias_through;
   return table;
 }
 

@@ -22,6 +22,8 @@ std::string parameter_line(const dds::ParameterEntry& p) {
                                  cell(p.relative_std_percent), status_name(p.status));
   if (!p.relation.empty()) line += "  = " + p.relation;
   if (!p.reason.empty()) line += "  " + p.reason;
+  if (!std::isnan(p.least_squares_value))
+    line += fmt::format("  (least squares {} +- {})", cell(p.least_squares_value), cell(p.least_squares_std));
   while (!line.empty() && line.back() == ' ') line.pop_back();
   return line + "\n";
 }
@@ -29,10 +31,11 @@ std::string parameter_line(const dds::ParameterEntry& p) {
 std::string parameter_json(const dds::ParameterEntry& p) {
   return fmt::format(
       "{{\"name\":{},\"unit\":{},\"value\":{},\"std\":{},\"relative_std_percent\":{},"
-      "\"status\":{},\"relation\":{},\"reason\":{}}}",
+      "\"status\":{},\"relation\":{},\"reason\":{},\"least_squares_value\":{},\"least_squares_std\":{}}}",
       json_string(p.name), json_string(p.unit), json_number(p.value),
       json_number(p.standard_deviation), json_number(p.relative_std_percent),
-      json_string(status_name(p.status)), json_string(p.relation), json_string(p.reason));
+      json_string(status_name(p.status)), json_string(p.relation), json_string(p.reason),
+      json_number(p.least_squares_value), json_number(p.least_squares_std));
 }
 
 }  // namespace
@@ -57,6 +60,8 @@ std::string format_estimate_text(const dds::EstimateTable& t) {
   if (!t.not_excited.empty())
     return out + fmt::format("  not excited by this run: {} ({} rows; --json has the numbers)\n",
                              t.not_excited, t.rows);
+  if (t.estimator != dds::kLeastSquares)
+    out += fmt::format("  values by {} (least squares is biased on this run: see the bias test below)\n", t.estimator);
   out += fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {}\n", "parameter", "unit", "value",
                      "std", "rel.std%", "status");
   for (const auto& p : t.parameters) out += parameter_line(p);
@@ -68,6 +73,8 @@ std::string format_estimate_text(const dds::EstimateTable& t) {
                        cell(g.residual_rms));
   if (!t.residual_verdict.empty())
     out += fmt::format("  residual loop (chunks through #{}): {}\n", t.residual_through, t.residual_statement);
+  if (!t.bias_test.empty())
+    out += fmt::format("  bias test (chunks through #{}): {}\n", t.bias_through, t.bias_test);
   return out;
 }
 
@@ -83,12 +90,14 @@ std::string estimate_json(const dds::EstimateTable& t) {
       "{{\"vehicle\":{},\"model\":{},\"source\":{},\"revision\":{},\"parameters\":[{}],"
       "\"rows\":{},\"effective_rows\":{},\"sigma\":{},\"condition_number\":{},"
       "\"residual_rms\":{},\"relative_residual_norm\":{},\"groups\":[{}],\"not_excited\":{},"
-      "\"residual_verdict\":{},\"residual_statement\":{},\"residual_through\":{}}}",
+      "\"residual_verdict\":{},\"residual_statement\":{},\"residual_through\":{},"
+      "\"estimator\":{},\"bias_test\":{},\"bias_through\":{}}}",
       json_string(t.vehicle), json_string(t.model), json_string(t.source), t.revision, parameters,
       t.rows, json_number(t.effective_rows), json_number(t.sigma),
       json_number(t.condition_number), json_number(t.residual_rms),
       json_number(t.relative_residual_norm), groups, json_string(t.not_excited),
-      json_string(t.residual_verdict), json_string(t.residual_statement), t.residual_through);
+      json_string(t.residual_verdict), json_string(t.residual_statement), t.residual_through,
+      json_string(t.estimator), json_string(t.bias_test), t.bias_through);
 }
 
 std::string estimates_json(const std::vector<dds::EstimateTable>& tables) {

@@ -11,6 +11,7 @@
 #include "dynid/dds/estimate_table.hpp"
 #include "dynid/ingest/run_processor.hpp"
 #include "dynid/report/excitation_report.hpp"
+#include "dynid/residual/iv_fit.hpp"
 
 namespace dynid::server {
 
@@ -23,6 +24,15 @@ dds::EstimateTable table_of(const std::string& vehicle, const std::string& sourc
                             const std::string& model,
                             const std::vector<model::ParameterInfo>& parameters,
                             const ls::WeightedEstimate& estimate);
+
+/// The instrumental-variable estimate on `table` (made by table_of from `parameters` and
+/// `estimate`): where iv.replaces_least_squares() (IV estimated, least squares rejected by the
+/// Durbin-Wu-Hausman test) the identified parameters get IV's values and HAC standard deviations,
+/// their statuses classified again on those, and the least-squares ones they replace; the test's
+/// one line (IvFit::statement()) either way, with `through`, the last chunk the IV fit includes.
+/// An IV fit of other columns (another effect set) is not applied: `table` is left as it is.
+void apply_iv(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
+              const ls::WeightedEstimate& estimate, const residual::IvFit& iv, std::uint64_t through);
 
 EstimateTables tables_of(const std::string& vehicle, const std::string& source,
                          const std::vector<ingest::ModelEstimate>& estimates,

@@ -228,8 +228,11 @@ class RunService {
   void start_residual_job();
   /// A finished diagnosis into its run, which is then published again.
   void collect_residual_job();
-  /// The run's live verdicts into its tables (nothing when off or not computed).
-  static void attach_residual(const RunState& run, EstimateTables& tables);
+  /// The run's live judgement into its tables (nothing when off or not computed): the residual
+  /// verdict, and the bias test with IV's values where it rejects least squares (apply_iv;
+  /// `estimates`: those the tables were made from).
+  static void attach_live(const RunState& run, const std::vector<ingest::ModelEstimate>& estimates,
+                          EstimateTables& tables);
   void publish_tables(const std::string& vehicle, EstimateTables tables);
   /// Publishes now every run of `vehicle` whose estimates changed since their last publication,
   /// in the order they changed.

@@ -9,6 +9,7 @@
 // Statuses are the base-parameter analysis' until the caller refines them
 // (apply_verdict(), with model::classify_parameters: poorly identified, not excited, implausible).
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,16 @@ struct ParameterEntry {
   ls::ParameterStatus status = ls::ParameterStatus::kIdentified;
   std::string relation;  ///< for kRegrouped: the base-parameter combination
   std::string reason = {};  ///< why the status (model/parameter_status.hpp); "" when identified
+  /// When the table's estimator is kInstrumentalVariables: the least-squares value and standard
+  /// deviation the row's replace (NaN for a row IV does not estimate, and under least squares).
+  double least_squares_value = std::numeric_limits<double>::quiet_NaN();
+  double least_squares_std = std::numeric_limits<double>::quiet_NaN();
 };
+
+/// EstimateTable::estimator: least squares (the fold's estimate, and what an older server
+/// publishes), or instrumental variables where the live bias test rejects least squares.
+inline constexpr const char* kLeastSquares = "least squares";
+inline constexpr const char* kInstrumentalVariables = "instrumental variables";
 
 struct GroupResidual {
   std::string group;
@@ -57,6 +67,13 @@ struct EstimateTable {
   std::string residual_verdict = {};
   std::string residual_statement = {};
   std::uint64_t residual_through = 0;
+  /// Whose values the rows are (kLeastSquares or kInstrumentalVariables: server/estimate_tables.hpp
+  /// apply_iv) and the bias test's one line (residual/iv_fit.hpp IvFit::statement(); "" when not
+  /// computed: the live judgement off, a pool, too few rows), `bias_through` the last chunk the
+  /// test includes.
+  std::string estimator = kLeastSquares;
+  std::string bias_test = {};
+  std::uint64_t bias_through = 0;
 };
 
 EstimateTable make_estimate_table(const std::string& vehicle, const std::string& model,
