@@ -61,4 +61,13 @@ std::string iv_verdicts(const std::vector<ParameterCoverage>& rows) {
   return out;
 }
 
+std::string published_verdicts(const std::vector<ParameterCoverage>& rows) {
+  std::string out;
+  for (const ParameterCoverage& r : rows)
+    out += "- " + r.model + " " + r.parameter + " as published (" + std::to_string(r.published.by_iv) + " of " +
+           std::to_string(r.published.seeds) + " seeds by IV): " + std_verdict("published", r.published.std) + "; " +
+           accuracy_verdict(r.parameter, r.published.mean_error_pct, r.published.errors_pct) + "\n";
+  return out;
+}
+
 }  // namespace dynid::benchcoverage

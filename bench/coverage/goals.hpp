@@ -22,4 +22,7 @@ std::string verdicts(const std::vector<ParameterCoverage>& rows);
 /// The same for the instrumental-variable estimate, with its refusals and DWH rejection rate.
 std::string iv_verdicts(const std::vector<ParameterCoverage>& rows);
 
+/// The same for what the product's table publishes (IV where the bias test rejects LS).
+std::string published_verdicts(const std::vector<ParameterCoverage>& rows);
+
 }  // namespace dynid::benchcoverage

@@ -83,8 +83,10 @@ int main(int argc, char** argv) {
   std::filesystem::remove_all(work_dir);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::vector<ParameterCoverage> rows = summarize(runs);
-  std::printf("\n%s\n%s\n%s\n%s\n%zu runs, %d failed, %.0f s\n", markdown_table(rows).c_str(), verdicts(rows).c_str(),
-              iv_markdown_table(rows).c_str(), iv_verdicts(rows).c_str(), runs.size(), errors_of(runs), seconds);
+  std::printf("\n%s\n%s\n%s\n%s\n%s\n%s\n%zu runs, %d failed, %.0f s\n", markdown_table(rows).c_str(),
+              verdicts(rows).c_str(), iv_markdown_table(rows).c_str(), iv_verdicts(rows).c_str(),
+              published_markdown_table(rows).c_str(), published_verdicts(rows).c_str(), runs.size(), errors_of(runs),
+              seconds);
   if (!o.json.empty() && !write_json(o.json, runs, rows, seconds)) return 1;
   return errors_of(runs) == 0 ? 0 : 1;
 }

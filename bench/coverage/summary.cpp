@@ -58,6 +58,25 @@ IvCoverage iv_of(const std::vector<const ParameterSample*>& samples) {
   return c;
 }
 
+PublishedCoverage published_of(const std::vector<const ParameterSample*>& samples) {
+  PublishedCoverage c;
+  std::vector<double> stds;
+  for (const ParameterSample* s : samples) {
+    const bool iv = s->dwh_rejects && std::isfinite(s->iv_value) && std::isfinite(s->iv_hac_std);
+    const double value = iv ? s->iv_value : s->value;
+    const double std = iv ? s->iv_hac_std : s->std;
+    if (!std::isfinite(value) || !std::isfinite(std)) continue;
+    c.by_iv += iv ? 1 : 0;
+    c.errors_pct.push_back(100.0 * (value - s->truth) / std::abs(s->truth));
+    stds.push_back(100.0 * std / std::abs(s->truth));
+  }
+  c.seeds = static_cast<int>(c.errors_pct.size());
+  c.mean_error_pct = mean(c.errors_pct);
+  c.scatter_pct = scatter(c.errors_pct);
+  c.std = coverage_of(c.errors_pct, stds);
+  return c;
+}
+
 ParameterCoverage row_of(const std::vector<const ParameterSample*>& samples) {
   ParameterCoverage row;
   row.model = samples.front()->model;
@@ -77,6 +96,7 @@ ParameterCoverage row_of(const std::vector<const ParameterSample*>& samples) {
   row.table = coverage_of(errors, table);
   row.hac = coverage_of(errors, hac);
   row.iv = iv_of(samples);
+  row.published = published_of(samples);
   return row;
 }
 
@@ -145,6 +165,19 @@ std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows) {
                  return start(r, "%+.3g %% | %d | %+.3g %% | %.3g %% |", r.mean_error_pct, r.iv.seeds,
                               r.iv.mean_error_pct, r.iv.scatter_pct) +
                         cells(r.iv.textbook) + cells(r.iv.hac) + formatted(" %.0f %% |", 100.0 * r.iv.dwh_rejections);
+               });
+}
+
+}  // namespace dynid::benchcoverage
+
+namespace dynid::benchcoverage {
+
+std::string published_markdown_table(const std::vector<ParameterCoverage>& rows) {
+  return table("| model | parameter | seeds | by IV | mean error | scatter | std | within 2 std | mean error / std |", rows,
+               [](const ParameterCoverage& r) {
+                 return start(r, "%d | %d | %+.3g %% | %.3g %% |", r.published.seeds, r.published.by_iv,
+                              r.published.mean_error_pct, r.published.scatter_pct) +
+                        cells(r.published.std);
                });
 }
 

@@ -29,6 +29,17 @@ struct IvCoverage {
   double dwh_rejections = kNaN;  ///< share of the seeds (IV estimated) where DWH rejects at 1 %
 };
 
+/// What the product's table publishes (server/estimate_tables.hpp apply_iv): IV's value and HAC
+/// std where the model's Durbin-Wu-Hausman test rejects least squares at 1 %, else the table's.
+struct PublishedCoverage {
+  int seeds = 0;     ///< seeds with a finite published value and std
+  int by_iv = 0;     ///< of which by IV
+  double mean_error_pct = kNaN;
+  double scatter_pct = kNaN;
+  std::vector<double> errors_pct;
+  StdCoverage std;
+};
+
 struct ParameterCoverage {
   std::string model;
   std::string parameter;
@@ -40,6 +51,7 @@ struct ParameterCoverage {
   StdCoverage table;             ///< the estimate table's std
   StdCoverage hac;               ///< the HAC std
   IvCoverage iv;
+  PublishedCoverage published;
 };
 
 /// One row per (model, parameter), in the order the runs first give them. A seed whose value or
@@ -51,5 +63,8 @@ std::string markdown_table(const std::vector<ParameterCoverage>& rows);
 
 /// The IV columns beside LS's mean error, as a markdown table.
 std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows);
+
+/// The published estimate's columns, as a markdown table.
+std::string published_markdown_table(const std::vector<ParameterCoverage>& rows);
 
 }  // namespace dynid::benchcoverage
