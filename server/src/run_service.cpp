@@ -421,7 +421,15 @@ void RunService::publish(const store::RunKey& key, RunState& run) {
   const auto estimates = run.processor.estimates();
   EstimateTables tables = tables_of(key.vehicle, key.run, estimates);
   attach_live(run, estimates, tables);
-  publish_tables(key.vehicle, std::move(tables));
+  publish_tables(key.vehicle, tables);
+  for (const dds::EstimateTable& table : tables.tables) run.published_revision[table.model] = table.revision;
+}
+
+void RunService::stamp_revisions(const RunState& run, EstimateTables& tables) {
+  for (dds::EstimateTable& table : tables.tables) {
+    const auto it = run.published_revision.find(table.model);
+    table.revision = it == run.published_revision.end() ? 0 : it->second;
+  }
 }
 
 void RunService::refresh_residual(const store::RunKey& key, const RunState& run) {
@@ -515,7 +523,7 @@ void RunService::attach_live(const RunState& run, const std::vector<ingest::Mode
   }
 }
 
-void RunService::publish_tables(const std::string& vehicle, EstimateTables tables) {
+void RunService::publish_tables(const std::string& vehicle, EstimateTables& tables) {
   auto& writers = outputs_.writers(context_.participant, vehicle);
   for (auto& table : tables.tables) {
     table.revision = context_.revisions.next();

@@ -90,9 +90,13 @@ EstimateTables RunService::estimate(const std::string& vehicle,
   const store::RunKey key{vehicle, run ? *run : latest_run(vehicle)};
   RunState& state = load(key);
   refresh_residual(key, state);  // a new verdict comes with a later publication
+  // Published first when it changed since its last publication: the reply's tables are then the
+  // topic's, revision for revision.
+  if (dirty_.contains(key)) publish(key, state);
   const auto estimates = state.processor.estimates();
   auto tables = tables_of(vehicle, key.run, estimates, model);
   attach_live(state, estimates, tables);
+  stamp_revisions(state, tables);
   if (model && tables.tables.empty() && tables.notes.empty())
     throw NotFound("run " + vehicle + "/" + key.run + " has no model " + *model);
   if (!state.halted.empty()) tables.notes.push_back(key.run + ": " + state.halted);
@@ -175,6 +179,7 @@ EstimateTables RunService::close(const std::string& vehicle, const std::string& 
   const auto estimates = state.processor.estimates();
   auto tables = tables_of(vehicle, run, estimates);
   attach_live(state, estimates, tables);
+  stamp_revisions(state, tables);
   record_history(key, tables);
   spdlog::info("run {}/{}: closed", vehicle, run);
   return tables;

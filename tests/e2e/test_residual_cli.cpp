@@ -195,6 +195,9 @@ TEST(E2eResidualCli, TheLiveVerdictIsPublishedBesideTheEstimates) {
   ASSERT_NE(it, published.end()) << watcher.seen();
   EXPECT_EQ(it->second.residual_verdict, table["residual_verdict"].get<std::string>());
   EXPECT_EQ(it->second.residual_through, last);
+  // The reply names the table by the revision it went out with on the topic (issue 18).
+  EXPECT_GT(table["revision"].get<std::uint64_t>(), 0u);
+  EXPECT_EQ(it->second.revision, table["revision"].get<std::uint64_t>());
   // The bias test runs beside it, and the table's values are the estimator it chooses. (Even
   // this quiet speed biases least squares measurably on so precise a run: sensor_scale -0.06 %,
   // 1.2 of its std; the next test holds the values themselves.)

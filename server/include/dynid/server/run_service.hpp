@@ -159,6 +159,9 @@ class RunService {
     std::string halted;
     std::uint64_t changed = 0;  // when it last changed, on changes_ (orders publications)
     std::chrono::steady_clock::time_point last_published{};
+    // Per model, the revision this run's table last went out with: a reply's tables carry it,
+    // so that a reply and the topic name one table by one revision.
+    std::map<std::string, std::uint64_t> published_revision;
     std::optional<std::uint64_t> unsaved_fold;  // folded through, not yet in the ledger
     std::vector<UnsavedCheckpoint> unsaved_checkpoints;
     // The live residual verdict (--live-residual): per model, and the chunks it includes.
@@ -233,7 +236,10 @@ class RunService {
   /// `estimates`: those the tables were made from).
   static void attach_live(const RunState& run, const std::vector<ingest::ModelEstimate>& estimates,
                           EstimateTables& tables);
-  void publish_tables(const std::string& vehicle, EstimateTables tables);
+  /// Writes `tables` to the Estimate topic, each with the next revision (set in `tables`).
+  void publish_tables(const std::string& vehicle, EstimateTables& tables);
+  /// Each table's revision as this run last published it (0: never published).
+  static void stamp_revisions(const RunState& run, EstimateTables& tables);
   /// Publishes now every run of `vehicle` whose estimates changed since their last publication,
   /// in the order they changed.
   void publish_pending(const std::string& vehicle);
