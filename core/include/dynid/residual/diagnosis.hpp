@@ -10,8 +10,10 @@
 //                   (Diagnosis::partial) and the verdict stays "structure left".
 //
 // The order is a closed test, so that the chance of an alarm on a run whose model lacks nothing
-// is stated: the floor test comes first, at level floor.error_rate (default 0.05: at most one
-// false alarm in 20 clean runs); only a residual above the floor is explained. Candidates are
+// is stated: the floor test comes first, at level floor.error_rate (default 0.025); only a
+// residual above the floor is explained. The one other way a clean run gets an alarm is the
+// hidden-structure test below, the better sensor's model against its own floor at the same
+// level: together at most 0.05, one false alarm in 20 clean runs (the union bound). Candidates are
 // then judged by the screen (HAC Wald test at family_error_rate / m, and a held-out gain), and a
 // significant candidate that takes the residual below the floor (its mean square under the
 // floor's lower critical ratio) is refused: a missing effect adds to the noise, so removing it
