@@ -129,16 +129,18 @@ hill_run="hill-$(date -u +%Y%m%dT%H%M%SZ)"
 # The live verdict of the closed run (its last chunk included) comes with a publication after the
 # close: the diagnosis runs beside the folding, not in the request.
 last_chunk=$(( $(sed -n 's/.*all chunks acknowledged: \([0-9]*\) stored.*/\1/p' "$work/hill-car.log" | tail -n 1) - 1 ))
-step "the server's live verdict on the run, published beside its estimates (dynid estimates --model)"
+step "the server's live judgement of the run, published beside its estimates (dynid estimates --model)"
 verdict=""
-for _ in $(seq 120); do
+for _ in $(seq 240); do
   verdict=$("$cli" --cyclone-config "$config" estimates --vehicle "$vehicle" --run "$hill_run" \
               --model longitudinal_wheel | grep "residual loop (chunks through #$last_chunk)" || true)
   [ -n "$verdict" ] && break
   sleep 0.5
 done
-[ -n "$verdict" ] || { echo "demo: no live residual verdict through chunk #$last_chunk within 60 s" >&2; exit 1; }
-echo "$verdict"
+[ -n "$verdict" ] || { echo "demo: no live residual verdict through chunk #$last_chunk within 120 s" >&2; exit 1; }
+# The whole table: the estimates with the loop's verdict and the bias test (least squares against
+# instrumental variables, docs/ACCURACY.md) beneath.
+"$cli" --cyclone-config "$config" estimates --vehicle "$vehicle" --run "$hill_run" --model longitudinal_wheel
 step "the residual loop on that run (dynid trace --model longitudinal_wheel --effects none)"
 hill_truth() { sed -n "/^\[$1\]/,/^\[/p" "$work/hill/truth.toml" | awk -F' = ' -v k="$2" '$1 == k { print $2; exit }'; }
 "$cli" --cyclone-config "$config" trace --vehicle "$vehicle" --run "$hill_run" --model longitudinal_wheel \
