@@ -24,7 +24,8 @@
 #
 # Environment: BUILD_DIR (default build), SCENARIO (default sine_steer, a file of
 # deploy/scenarios/), SEED (the scenario's own by default), DEMO_SKIP_SETUP=1 to use an existing
-# build as it is, KEEP=1 to keep the temporary folder (store, logs, spool).
+# build as it is, KEEP=1 to keep the temporary folder (store, logs, spool), DEMO_DOMAIN=<id> to run
+# untagged on that DDS domain so that another DDS implementation can join (docs/INTEROP.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -56,8 +57,17 @@ cleanup() {
 trap cleanup EXIT
 
 # loopback.xml, plus a discovery tag of this demo, so that tests or another demo running on the
-# same machine stay out of it.
-config="file://$root/deploy/cyclonedds/loopback.xml,<Discovery><Tag>dynid-demo-$$</Tag></Discovery>"
+# same machine stay out of it. A tagged participant ignores every participant without its tag,
+# and other DDS implementations have none: with DEMO_DOMAIN set, the demo runs untagged on that
+# domain instead, for a third-party client to join (docs/INTEROP.md; e.g. Fast DDS with
+# deploy/fastdds/loopback.xml on the same domain id). Pick a domain nothing else uses.
+if [ -n "${DEMO_DOMAIN:-}" ]; then
+  config="file://$root/deploy/cyclonedds/loopback.xml"
+  domain_args=(--domain "$DEMO_DOMAIN")
+else
+  config="file://$root/deploy/cyclonedds/loopback.xml,<Discovery><Tag>dynid-demo-$$</Tag></Discovery>"
+  domain_args=()
+fi
 start=$(date +%s.%N)
 step() { awk -v s="$start" -v n="$(date +%s.%N)" -v m="$1" 'BEGIN { printf "\n== %s (%.1f s)\n", m, n - s }'; }
 
@@ -70,12 +80,12 @@ step "starting dynid-server (store $work/store.db, log $work/server.log)"
 # kill the server instead of stopping it cleanly. The server folds on its own workers anyway.
 # --live-residual 2: the residual loop's verdict of each model, kept current as the run streams (at
 # most every 2 s of its growth, and at its close) and published beside the estimates.
-OPENBLAS_NUM_THREADS=1 "$server" --store "$work/store.db" --cyclone-config "$config" --live-residual 2 \
+OPENBLAS_NUM_THREADS=1 "$server" --store "$work/store.db" --cyclone-config "$config" "${domain_args[@]}" --live-residual 2 \
   > "$work/server.log" 2>&1 &
 server_pid=$!
 
 step "dynid-car: replaying can.log as run $run_id"
-"$car" --profile deploy/profiles/testcar.toml --cyclone-config "$config" --replay "$work/run/can.log" \
+"$car" --profile deploy/profiles/testcar.toml --cyclone-config "$config" "${domain_args[@]}" --replay "$work/run/can.log" \
   --fast --spool "$work/spool" --run "$run_id" --drain-timeout 60 || {
   echo "demo: dynid-car failed; the server's log:" >&2
   tail -n 30 "$work/server.log" >&2
@@ -83,17 +93,17 @@ step "dynid-car: replaying can.log as run $run_id"
 }
 
 step "closing the run and asking for the estimates (dynid estimates --vehicle $vehicle)"
-"$cli" --cyclone-config "$config" close --vehicle "$vehicle" --run "$run_id" > /dev/null
-"$cli" --cyclone-config "$config" estimates --vehicle "$vehicle"
+"$cli" --cyclone-config "$config" "${domain_args[@]}" close --vehicle "$vehicle" --run "$run_id" > /dev/null
+"$cli" --cyclone-config "$config" "${domain_args[@]}" estimates --vehicle "$vehicle"
 
 step "what this run identifies, and the manoeuvres for the rest (dynid excitation --vehicle $vehicle)"
-"$cli" --cyclone-config "$config" excitation --vehicle "$vehicle"
+"$cli" --cyclone-config "$config" "${domain_args[@]}" excitation --vehicle "$vehicle"
 
 # The profile runs the lateral model bare. The effects the accuracy test found (tyre
 # saturation, sensor offsets in the slip angles, roll acceleration; docs/ACCURACY.md) take its
 # ~10 % bias away: a reprocess replays the stored chunks with them, as an engineer would.
 step "reprocessing the run's lateral model with the effects of docs/ACCURACY.md"
-"$cli" --cyclone-config "$config" reprocess --vehicle "$vehicle" --run "$run_id" --model lateral_bicycle --effects tyre_saturation,slip_offset,roll_acceleration
+"$cli" --cyclone-config "$config" "${domain_args[@]}" reprocess --vehicle "$vehicle" --run "$run_id" --model lateral_bicycle --effects tyre_saturation,slip_offset,roll_acceleration
 
 step "the simulated car's truth ($work/run/truth.toml)"
 truth() { sed -n "/^\[$1\]/,/^\[/p" "$work/run/truth.toml" | awk -F' = ' -v k="$2" '$1 == k { print $2; exit }'; }
@@ -119,20 +129,20 @@ step "closing the loop: a run with an effect its model does not declare"
 # again, and prints the parameters and residual before and after against the simulated truth.
 hill_run="hill-$(date -u +%Y%m%dT%H%M%SZ)"
 "$sim" --scenario deploy/scenarios/hill_acceleration.toml ${SEED:+--seed "$SEED"} --out "$work/hill"
-"$car" --profile deploy/profiles/testcar.toml --cyclone-config "$config" --replay "$work/hill/can.log" \
+"$car" --profile deploy/profiles/testcar.toml --cyclone-config "$config" "${domain_args[@]}" --replay "$work/hill/can.log" \
   --fast --spool "$work/spool" --run "$hill_run" --drain-timeout 60 2> "$work/hill-car.log" || {
   echo "demo: dynid-car failed on the hill run:" >&2
   tail -n 20 "$work/hill-car.log" >&2
   exit 1
 }
-"$cli" --cyclone-config "$config" close --vehicle "$vehicle" --run "$hill_run" > /dev/null
+"$cli" --cyclone-config "$config" "${domain_args[@]}" close --vehicle "$vehicle" --run "$hill_run" > /dev/null
 # The live verdict of the closed run (its last chunk included) comes with a publication after the
 # close: the diagnosis runs beside the folding, not in the request.
 last_chunk=$(( $(sed -n 's/.*all chunks acknowledged: \([0-9]*\) stored.*/\1/p' "$work/hill-car.log" | tail -n 1) - 1 ))
 step "the server's live judgement of the run, published beside its estimates (dynid estimates --model)"
 verdict=""
 for _ in $(seq 240); do
-  verdict=$("$cli" --cyclone-config "$config" estimates --vehicle "$vehicle" --run "$hill_run" \
+  verdict=$("$cli" --cyclone-config "$config" "${domain_args[@]}" estimates --vehicle "$vehicle" --run "$hill_run" \
               --model longitudinal_wheel | grep "residual loop (chunks through #$last_chunk)" || true)
   [ -n "$verdict" ] && break
   sleep 0.5
@@ -140,10 +150,11 @@ done
 [ -n "$verdict" ] || { echo "demo: no live residual verdict through chunk #$last_chunk within 120 s" >&2; exit 1; }
 # The whole table: the estimates with the loop's verdict and the bias test (least squares against
 # instrumental variables, docs/ACCURACY.md) beneath.
-"$cli" --cyclone-config "$config" estimates --vehicle "$vehicle" --run "$hill_run" --model longitudinal_wheel
+"$cli" --cyclone-config "$config" "${domain_args[@]}" estimates --vehicle "$vehicle" --run "$hill_run" \
+  --model longitudinal_wheel
 step "the residual loop on that run (dynid trace --model longitudinal_wheel --effects none)"
 hill_truth() { sed -n "/^\[$1\]/,/^\[/p" "$work/hill/truth.toml" | awk -F' = ' -v k="$2" '$1 == k { print $2; exit }'; }
-"$cli" --cyclone-config "$config" trace --vehicle "$vehicle" --run "$hill_run" --model longitudinal_wheel \
+"$cli" --cyclone-config "$config" "${domain_args[@]}" trace --vehicle "$vehicle" --run "$hill_run" --model longitudinal_wheel \
   --effects none --reference "mass=$(hill_truth vehicle longitudinal_equivalent_mass)" \
   --reference "SCx=$(hill_truth vehicle scx)" \
   --reference "rolling_resistance=$(hill_truth vehicle road_load_constant_force)"

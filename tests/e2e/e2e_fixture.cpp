@@ -58,13 +58,24 @@ TempDir::~TempDir() {
   std::filesystem::remove_all(path_, ignored);
 }
 
+namespace {
+// Set once by use_open_network(), before the first participant.
+std::optional<dds_domainid_t> open_domain;
+}  // namespace
+
 std::string loopback_config() {
-  return dds::config_file_uri(std::string(DYNID_SOURCE_DIR) + "/deploy/cyclonedds/loopback.xml") +
-         ",<Discovery><Tag>" + process_tag() + "</Tag></Discovery>";
+  const std::string file =
+      dds::config_file_uri(std::string(DYNID_SOURCE_DIR) + "/deploy/cyclonedds/loopback.xml");
+  if (open_domain) return file;
+  return file + ",<Discovery><Tag>" + process_tag() + "</Tag></Discovery>";
 }
 
+dds_domainid_t domain() { return open_domain.value_or(kDomain); }
+
+void use_open_network(dds_domainid_t domain_id) { open_domain = domain_id; }
+
 dds::Participant& participant() {
-  static dds::Participant p({kDomain, loopback_config()});
+  static dds::Participant p({domain(), loopback_config()});
   return p;
 }
 
@@ -72,7 +83,7 @@ server::ServerOptions server_options(const std::string& store_path) {
   server::ServerOptions o;
   o.store_path = store_path;
   o.cyclone_config = loopback_config();
-  o.domain = kDomain;
+  o.domain = domain();
   o.threads = 2;
   o.checkpoint_every = 4;
   o.publish_interval = 20ms;
@@ -128,9 +139,11 @@ std::optional<int> ServerProcess::wait(std::chrono::milliseconds timeout) {
   return std::nullopt;
 }
 
-CommandResult run_dynid(const std::vector<std::string>& arguments, int timeout_s, dds_domainid_t domain) {
+CommandResult run_dynid(const std::vector<std::string>& arguments, int timeout_s,
+                        std::optional<dds_domainid_t> domain_id) {
   std::vector<std::string> argv{DYNID_CLI_EXE, "--cyclone-config", loopback_config(), "--domain",
-                                std::to_string(domain), "--timeout", std::to_string(timeout_s)};
+                                std::to_string(domain_id.value_or(domain())), "--timeout",
+                                std::to_string(timeout_s)};
   argv.insert(argv.end(), arguments.begin(), arguments.end());
   return run_command(argv, std::chrono::seconds(2 * timeout_s));
 }

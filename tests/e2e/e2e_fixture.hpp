@@ -45,9 +45,17 @@ class TempDir {
   std::filesystem::path path_;
 };
 
-/// deploy/cyclonedds/loopback.xml plus this process's discovery tag.
+/// deploy/cyclonedds/loopback.xml plus this process's discovery tag (without the tag after
+/// use_open_network()).
 std::string loopback_config();
-dds::Participant& participant();  // one per test process, on kDomain
+/// The domain of this process's participants, the server's and the CLI's: kDomain unless
+/// use_open_network() chose another.
+dds_domainid_t domain();
+/// tests/interop: everything on `domain_id` with loopback.xml and no discovery tag, since a
+/// participant of another DDS implementation carries no Cyclone tag and a tagged participant
+/// ignores it. The domain id of its own then isolates the test. Call before participant().
+void use_open_network(dds_domainid_t domain_id);
+dds::Participant& participant();  // one per test process, on domain()
 
 server::ServerOptions server_options(const std::string& store_path);
 
@@ -82,10 +90,10 @@ struct CommandResult {
 };
 /// Runs a program (no shell) and captures its output; exit_code -1 on timeout (then killed).
 CommandResult run_command(const std::vector<std::string>& argv, std::chrono::milliseconds timeout);
-/// The dynid CLI (DYNID_CLI_EXE) with the loopback configuration on `domain`, its request
+/// The dynid CLI (DYNID_CLI_EXE) with the loopback configuration on `domain_id`, its request
 /// timeout `timeout_s`; killed after twice that.
 CommandResult run_dynid(const std::vector<std::string>& arguments, int timeout_s = 10,
-                        dds_domainid_t domain = kDomain);
+                        std::optional<dds_domainid_t> domain_id = std::nullopt);  // domain()
 
 /// A car: announces runs and publishes chunks of one vehicle, reads its acknowledgements.
 class TestCar {

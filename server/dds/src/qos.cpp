@@ -6,6 +6,15 @@ namespace {
 
 dds_duration_t to_duration(std::chrono::milliseconds value) { return DDS_MSECS(value.count()); }
 
+// XCDR1 on every endpoint: Cyclone would otherwise offer XCDR2 too, which Fast DDS 2.9 (and
+// other XCDR1-only implementations) cannot decode; one representation also keeps the wire
+// bytes of a sample the same whichever dynid process wrote it.
+Qos with_xcdr1(Qos qos) {
+  const dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+  dds_qset_data_representation(qos.get(), 1, &xcdr1);
+  return qos;
+}
+
 }  // namespace
 
 Qos::Qos(const Qos& other) : qos_(dds_create_qos()) { dds_copy_qos(qos_, other.qos_); }
@@ -33,7 +42,7 @@ Qos reliable_keep_all(const KeepAllLimits& limits) {
   dds_qset_history(qos.get(), DDS_HISTORY_KEEP_ALL, 0);
   dds_qset_resource_limits(qos.get(), limits.max_samples, limits.max_instances,
                            limits.max_samples_per_instance);
-  return qos;
+  return with_xcdr1(qos);
 }
 
 }  // namespace
@@ -51,7 +60,7 @@ Qos state_qos() {
                               DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
   // A writer that goes away (server restart) leaves its last states alive in readers.
   dds_qset_writer_data_lifecycle(qos.get(), false);
-  return qos;
+  return with_xcdr1(qos);
 }
 
 Qos request_qos(const KeepAllLimits& limits) { return reliable_keep_all(limits); }

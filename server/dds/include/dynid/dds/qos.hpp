@@ -11,6 +11,9 @@
 //                 not withdraw the last estimate from readers that have it).
 //   request_qos   reliable, volatile, keep-all within kRequestLimits (requests and
 //                 replies: an engineer's second request must not overwrite the first).
+// Every profile pins the data representation to XCDR1 (plain CDR), the encoding of the @final
+// wire types that every DDS implementation reads and writes (idl/dynid.idl, docs/INTEROP.md):
+// a writer announces it and a reader accepts only it.
 // Partitions are set per reader/writer (see topics.hpp); the profiles carry none.
 #include <dds/dds.h>
 
