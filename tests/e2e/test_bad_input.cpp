@@ -101,8 +101,13 @@ TEST(E2eBadInput, MalformedChunksAreRejectedWithReasonsAndChangeNothing) {
     EXPECT_NE(receipt->rejections.back().reason.find(bad.expected), std::string::npos)
         << bad.what << ": the reason should say '" << bad.expected << "'\n" << reasons(*receipt);
     EXPECT_EQ(receipt->highest_contiguous, run_id == "run-b" ? 0 : -1) << bad.what;
-    if (run_id == "run-b") ++rejections;
-    EXPECT_EQ(server.server().counters().chunks_rejected, before + 1) << bad.what;
+    if (run_id == "run-b") {
+      ++rejections;
+      EXPECT_EQ(receipt->rejections.size(), rejections) << bad.what << ": one rejection per bad chunk";
+    }
+    // The counter is server-wide: the good car's chunks that race its own announcement are
+    // rejected (and resent) too, so only a lower bound holds here.
+    EXPECT_GE(server.server().counters().chunks_rejected, before + 1) << bad.what;
   }
 
   // An exact duplicate is re-acknowledged, counted, and not folded again.
