@@ -10,28 +10,13 @@
 #include <dynid/input/input_file.hpp>
 #include <dynid/input/number.hpp>
 
+#include "dynid/car/auxiliary_csv.hpp"
 #include "dynid/car/log_source.hpp"
 #include "dynid/car/signal_mapper.hpp"
 #include "dynid/error.hpp"
 
 namespace dynid::car {
 namespace {
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
-std::vector<std::string_view> cells(std::string_view line) {
-  std::vector<std::string_view> out;
-  for (;;) {
-    const std::size_t comma = line.find(',');
-    out.push_back(trim(line.substr(0, comma)));
-    if (comma == std::string_view::npos) return out;
-    line.remove_prefix(comma + 1);
-  }
-}
 
 std::string fmt(double v, int digits = 3) {
   char buf[48];
@@ -52,86 +37,33 @@ std::string drift_text(const ClockEstimate& e) {
 AuxiliaryTable read_auxiliary_csv(const AuxiliarySourceSpec& spec, const std::filesystem::path& file) {
   const std::string text = input::read_input_file(file, "auxiliary source '" + spec.name + "'", kMaxAuxiliaryFileBytes);
   const std::string where = file.string();
-  std::size_t pos = 0, line_no = 0;
-  const auto next_line = [&](std::string_view& line) {
-    if (pos >= text.size()) return false;
-    const std::size_t nl = text.find('\n', pos);
-    line = std::string_view(text).substr(pos, nl == std::string::npos ? std::string::npos : nl - pos);
-    pos = nl == std::string::npos ? text.size() : nl + 1;
-    ++line_no;
-    return true;
-  };
-  std::string_view line;
-  if (!next_line(line)) throw InputError(where + ": auxiliary source '" + spec.name + "': empty file (no header line)");
-  const std::vector<std::string_view> header = cells(line);
-  const auto column = [&](const std::string& name) -> std::size_t {
-    for (std::size_t i = 0; i < header.size(); ++i)
-      if (header[i] == name) return i;
-    std::string have;
-    for (auto h : header) have += (have.empty() ? "" : ", ") + input::printable(h);
-    throw InputError(where + ":1: auxiliary source '" + spec.name + "': no column '" + name + "' in the header (columns: " +
-                     have + ")");
-  };
-  const std::size_t time_col = column(spec.time_column);
-  std::vector<std::size_t> cols;
-  for (const auto& c : spec.channels) cols.push_back(column(c.column));
-
+  AuxiliaryCsvParser parser(spec, where);
   AuxiliaryTable t;
   t.values.resize(spec.channels.size());
-  std::size_t repeated = 0, non_finite = 0;
-  while (next_line(line)) {
-    if (trim(line).empty()) continue;
-    const std::vector<std::string_view> row = cells(line);
-    const std::string at = where + ":" + std::to_string(line_no) + ": ";
-    if (row.size() != header.size())
-      throw InputError(at + std::to_string(row.size()) + " cells, the header has " + std::to_string(header.size()));
-    const auto time = input::parse_finite(row[time_col]);
-    if (!time) throw InputError(at + "time '" + input::printable(row[time_col]) + "' is not a finite number");
-    const double seconds = *time * spec.time_scale;
-    if (!t.time.empty() && seconds < t.time.back())
-      throw InputError(at + "time " + std::to_string(seconds) + " s is before the previous row's " +
-                       std::to_string(t.time.back()) + " s: the rows must be sorted by time");
-    if (!t.time.empty() && seconds == t.time.back()) {
-      ++repeated;
-      continue;
-    }
-    t.time.push_back(seconds);
-    for (std::size_t j = 0; j < cols.size(); ++j) {
-      const std::string_view cell = row[cols[j]];
-      double v = std::numeric_limits<double>::quiet_NaN();
-      if (!cell.empty()) {
-        if (cell == "nan" || cell == "NaN" || cell == "inf" || cell == "-inf") {
-          ++non_finite;
-        } else if (const auto x = input::parse_finite(cell)) {
-          v = *x;
-        } else {
-          throw InputError(at + "column '" + spec.channels[j].column + "': '" + input::printable(cell) +
-                           "' is not a number");
-        }
-      }
-      t.values[j].push_back(v);
-    }
+  for (std::size_t pos = 0; pos < text.size();) {
+    const std::size_t nl = text.find('\n', pos);
+    const std::string_view line = std::string_view(text).substr(pos, nl == std::string::npos ? std::string::npos : nl - pos);
+    pos = nl == std::string::npos ? text.size() : nl + 1;
+    const auto row = parser.line(line);
+    if (!row) continue;
+    t.time.push_back(row->time);
+    for (std::size_t j = 0; j < row->values.size(); ++j) t.values[j].push_back(row->values[j]);
   }
+  if (!parser.has_header()) throw InputError(where + ": auxiliary source '" + spec.name + "': empty file (no header line)");
   if (t.time.size() < 2) throw InputError(where + ": auxiliary source '" + spec.name + "': fewer than 2 rows of data");
-  if (repeated > 0)
-    t.warnings.push_back(where + ": " + std::to_string(repeated) + " rows repeating the previous row's time dropped");
-  if (non_finite > 0)
-    t.warnings.push_back(where + ": " + std::to_string(non_finite) + " non-finite values (nan, inf) left out");
-  if (header.size() > cols.size() + 1) {
-    std::set<std::size_t> used(cols.begin(), cols.end());
-    used.insert(time_col);
-    std::string ignored;
-    for (std::size_t i = 0; i < header.size(); ++i)
-      if (!used.count(i)) ignored += (ignored.empty() ? "" : ", ") + input::printable(header[i]);
-    t.unmapped_columns = ignored;
-  }
+  if (parser.repeated() > 0)
+    t.warnings.push_back(where + ": " + std::to_string(parser.repeated()) + " rows repeating the previous row's time dropped");
+  if (parser.non_finite() > 0)
+    t.warnings.push_back(where + ": " + std::to_string(parser.non_finite()) + " non-finite values (nan, inf) left out");
+  t.unmapped_columns = parser.unmapped_columns();
   return t;
 }
 
 std::string SourceReport::describe() const {
   if (file.empty()) return "source '" + name + "': not given for this run (--source " + name + "=FILE): left out";
-  std::string s = "source '" + name + "' (" + file.filename().string() + "): " + std::to_string(samples) +
-                  " samples" + (unmapped_columns.empty() ? "" : " (columns not mapped: " + unmapped_columns + ")") +
+  std::string s = "source '" + name + "' (" + file.filename().string() + "): " +
+                  (followed ? "followed as it is written" : std::to_string(samples) + " samples") +
+                  (unmapped_columns.empty() ? "" : " (columns not mapped: " + unmapped_columns + ")") +
                   ", clock offset " + fmt(offset) + " s";
   if (estimate)
     s += " +- " + fmt(estimate->std).substr(1) + " s (bus time = source time + offset; estimated, peak correlation " +
@@ -200,7 +132,7 @@ std::vector<TimeSeries> read_source(const AuxiliarySourceSpec& spec, SourceRepor
         const double v = table.values[ci][i];
         if (!std::isfinite(v)) continue;
         series[ci].t.push_back(table.time[i]);
-        series[ci].v.push_back(spec.channels[ci].gain * spec.channels[ci].to_si.apply(v));
+        series[ci].v.push_back(auxiliary_si(spec, ci, v));
       }
     return series;
   }
@@ -236,7 +168,7 @@ std::vector<TimeSeries> read_source(const AuxiliarySourceSpec& spec, SourceRepor
 }  // namespace
 
 RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::string, std::filesystem::path>& given,
-                           FrameSource* bus) {
+                           FrameSource* bus, bool live) {
   for (const auto& [name, path] : given) {
     bool known = false;
     std::string names;
@@ -246,7 +178,7 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
                        declared.source.filename().string() + " declares no source '" + input::printable(name) +
                        "' (declared: " + (names.empty() ? "none" : names) + ")");
   }
-  RunSources run{declared, {}, {}};
+  RunSources run{declared, {}, {}, {}};
   std::vector<std::vector<TimeSeries>> series(declared.sources.size());
   std::set<std::size_t> wanted;
   for (std::size_t si = 0; si < declared.sources.size(); ++si) {
@@ -256,7 +188,10 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
     const auto it = given.find(spec.name);
     report.file = it != given.end() ? it->second : spec.file;
     if (!report.file.empty()) {
-      series[si] = read_source(spec, report);
+      if (live && spec.type != "csv")
+        throw InputError("source '" + spec.name + "' (" + report.file.string() + "): a second CAN bus is read from its "
+                         "log, in a replay; a live run follows CSV sources (a file or named pipe being written)");
+      if (!live) series[si] = read_source(spec, report);
       if (spec.clock.offset) {
         report.offset = *spec.clock.offset;
       } else {
@@ -301,6 +236,11 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
     std::vector<std::size_t> column_of(spec.channels.size());
     for (std::size_t c = 0; c < run.profile.channels.size(); ++c)
       if (run.profile.channels[c].source == si) column_of[run.profile.channels[c].source_channel] = c;
+    if (live) {
+      report.followed = true;
+      run.followed.push_back({std::make_unique<AuxiliaryFollower>(spec, report.file, report.offset), column_of, spec.wait});
+      continue;
+    }
     for (std::size_t ci = 0; ci < spec.channels.size(); ++ci)
       for (std::size_t i = 0; i < series[si][ci].t.size(); ++i) {
         run.samples.push_back({series[si][ci].t[i] + report.offset, column_of[ci], series[si][ci].v[i]});

@@ -40,6 +40,13 @@ void CarPipeline::add_auxiliary(std::vector<AuxiliarySample> samples) {
   aux_next_ = 0;
 }
 
+void CarPipeline::append_auxiliary(std::vector<AuxiliarySample> samples) {
+  // What was pushed already goes, so a long live run keeps only what is still to come.
+  aux_.erase(aux_.begin(), aux_.begin() + static_cast<std::ptrdiff_t>(aux_next_));
+  aux_next_ = 0;
+  aux_.insert(aux_.end(), std::make_move_iterator(samples.begin()), std::make_move_iterator(samples.end()));
+}
+
 // Auxiliary samples up to `source_time` into the resampler (those before the first frame dropped).
 void CarPipeline::push_auxiliary_until(double source_time) {
   for (; aux_next_ < aux_.size() && aux_[aux_next_].time <= source_time; ++aux_next_) {

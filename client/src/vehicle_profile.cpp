@@ -395,7 +395,7 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
     if (s.type != "csv" && s.type != "can")
       r.fail(key + ".type", "unknown source type '" + s.type + "' (\"csv\" or \"can\")", t.get("type"));
     if (s.type == "csv")
-      r.only_keys(t, {"name", "type", "file", "time_column", "time_unit", "clock", "channels"}, key + ".");
+      r.only_keys(t, {"name", "type", "file", "time_column", "time_unit", "clock", "wait", "channels"}, key + ".");
     else
       r.only_keys(t, {"name", "type", "file", "dbc", "interfaces", "clock", "channels"}, key + ".");
     s.name = r.string(t, "name", key + ".name");
@@ -420,6 +420,7 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
       read_bus(r, t, key + ".", *bus);
     }
     s.clock = read_clock(r, t, key);
+    if (t.contains("wait")) s.wait = r.at_most(t, "wait", key + ".wait", kMaxSourceWait);
     const toml::node* cn = t.get("channels");
     const toml::array* ca = cn == nullptr ? nullptr : cn->as_array();
     if (ca == nullptr || !ca->is_array_of_tables() || ca->empty())

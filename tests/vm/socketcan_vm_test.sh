@@ -6,10 +6,12 @@
 # frames (ids, flags, payloads; the error frame counted, not returned) with sane kernel
 # timestamps (non-decreasing, wall-clock, paced like the log). Then: kernel filters, a time
 # limit on a silent bus and SIGTERM, each ending the dump cleanly.
-# Beside the dump, dynid-car reads the same frames live with the vehicle profile (--chunks-out);
-# on this machine the dump is replayed through the same pipeline (--replay --chunks-out), and
-# the two chunk files must be identical byte for byte: the live path cuts exactly the chunks a
-# replay of the received frames cuts (the RAV4 log and DBC are needed for this part).
+# Beside the dump, dynid-car reads the same frames live with the vehicle profile (--chunks-out),
+# and the recorder IMU from a named pipe a logger writes into (an auxiliary source followed live);
+# on this machine the dump and the logger's rows are replayed through the same pipeline
+# (--replay --source --chunks-out), and the two chunk files must be identical byte for byte: the
+# live path cuts exactly the chunks a replay of what it received cuts (the RAV4 log and DBC are
+# needed for this part).
 #
 #   socketcan_vm_test.sh --dump BIN --tool BIN --car BIN --profile TOML --work DIR --cache DIR
 #                        [--shared-data DIR]
@@ -46,6 +48,7 @@ readonly LOG_SECONDS=3        # of the real log (or of a generated one)
 readonly PLAYED_IFACE=can0
 readonly CAR_RUN=vm-live      # the same run id live and replayed: it is part of every chunk
 readonly CAR_GRACE=15         # s after the dump ended for dynid-car to reach the same frame count
+readonly AUX_SECONDS=30       # the IMU logger's longest life; it ends when dynid-car has
 
 as_root() {
   if [ "$(id -u)" -eq 0 ]; then "$@"
@@ -179,9 +182,13 @@ make_car_profile() {
   dbc=$(profile_dbc)
   mkdir -p "$work/car"
   cp "$dbc" "$work/car/car.dbc"
+  # The recorder IMU source follows a named pipe in the live run: its clock fixed (the logger
+  # writes the bus's wall-clock time), the bus held up to 5 s for it (TCG is slow).
   sed -e 's/^dbc *= *".*"/dbc = "car.dbc"/' -e 's/^interfaces *= *\[.*\]/interfaces = ["vcan0"]/' \
+    -e 's/^clock = { estimate_from.*/clock = { offset = 0.0 }\nwait = 5.0/' \
     "$profile" >"$work/car/car.toml"
   grep -q '^interfaces = \["vcan0"\]' "$work/car/car.toml" || fail "$profile names no interfaces = [...]"
+  grep -q '^wait = 5.0' "$work/car/car.toml" || fail "$profile: no [[sources]] clock = { estimate_from ... } line to fix"
 }
 
 make_expected_log() {
@@ -196,7 +203,7 @@ write_init() {
     echo '#!/bin/busybox sh'
     echo "MODULES='${modules[*]}' EXPECTED=$expected PLAYED_IFACE=$PLAYED_IFACE"
     echo "ERROR_SEND='$ERROR_SEND' EXTRA_SEND='${EXTRA_SEND[*]}'"
-    echo "CAR_RUN=$CAR_RUN CAR_GRACE=$CAR_GRACE"
+    echo "CAR_RUN=$CAR_RUN CAR_GRACE=$CAR_GRACE AUX_SECONDS=$AUX_SECONDS"
     cat <<'INIT'
 /bin/busybox --install -s /bin
 # The firmware's "Booting from ROM.." ends without a newline on the serial console: end that line
@@ -225,14 +232,18 @@ ip link add dev vcan0 type vcan && ip link set vcan0 mtu 72 && ip link set up vc
 # 1. The log, then the extra frames and an error frame; ends after EXPECTED frames. dynid-car
 #    reads them too, live, and writes its chunks; stopping at the same frame count (not on a
 #    signal) leaves no silent-bus time after the last frame, which a replay could not know of.
+#    Beside the bus, a logger writes the recorder IMU's rows into a named pipe that dynid-car
+#    follows (--source); a copy of the rows goes to the host for the replay.
 dynid-socketcan-dump --frames $EXPECTED --seconds 60 --output /tmp/dump.log vcan0 \
   2>/tmp/dump.err &
 dump=$!
+mkfifo /tmp/imu.pipe || vmfail "mkfifo"
 dynid-car --profile /test/car/car.toml --run $CAR_RUN --can vcan0 --max-frames $EXPECTED \
-  --chunks-out /tmp/live.chunks 2>/tmp/car.err &
+  --source recorder_imu=/tmp/imu.pipe --chunks-out /tmp/live.chunks 2>/tmp/car.err &
 car=$!
 ready /tmp/dump.err
 ready /tmp/car.err
+vm_log_tool aux-writer /tmp/imu.pipe /tmp/imu.csv $AUX_SECONDS 2>/tmp/aux.err &
 canplayer -I /test/input.log vcan0=$PLAYED_IFACE || vmfail "canplayer"
 cansend vcan0 $ERROR_SEND || vmfail "cansend $ERROR_SEND"
 for f in $EXTRA_SEND; do cansend vcan0 "$f" || vmfail "cansend $f"; done
@@ -268,6 +279,8 @@ echo "DYNID-TERM-STATUS $? $(grep -c . /tmp/term.log)"
 section DUMP /tmp/dump.log
 section FILTER /tmp/filter.log
 echo DYNID-CHUNKS-BEGIN; base64 /tmp/live.chunks; echo DYNID-CHUNKS-END
+cat /tmp/aux.err
+echo DYNID-IMU-BEGIN; base64 /tmp/imu.csv; echo DYNID-IMU-END
 poweroff -f
 INIT
   } >"$root/init"
@@ -289,6 +302,7 @@ build_initramfs() {
   copy_program "$(command -v cansend)" /opt/bin/cansend
   copy_program "$dump_bin" /opt/bin/dynid-socketcan-dump
   copy_program "$car_bin" /opt/bin/dynid-car
+  copy_program "$tool_bin" /opt/bin/vm_log_tool
   cp -r "$work/car" "$root/test/car"
   cp "$work/input.log" "$root/test/input.log"
   write_init
@@ -348,8 +362,14 @@ check_chunks() {
     fail "dynid-car --can vcan0 --chunks-out failed or did not receive $expected frames in the VM"
   grep -q "^DYNID-CHUNKS-END" "$work/serial.txt" || fail "no live chunks on the serial console"
   section CHUNKS | base64 -d >"$work/live.chunks" || fail "the live chunks did not decode from base64"
+  section IMU | base64 -d >"$work/imu.csv" || fail "the IMU logger's copy did not decode from base64"
+  grep -E "followed live\): [1-9][0-9]* rows" "$work/serial.txt" ||
+    fail "dynid-car read no row of the IMU it followed live"
+  grep -q "samples merged into the grid" "$work/serial.txt" || fail "no IMU sample merged live"
+  ! grep -q "frames let in at the end of a source's wait" "$work/serial.txt" ||
+    fail "the live bus outran its IMU source's wait: the comparison below cannot hold"
   "$car_bin" --profile "$work/car/car.toml" --run "$CAR_RUN" --replay "$work/dump.log" --fast \
-    --chunks-out "$work/replay.chunks" 2>"$work/replay.err" ||
+    --source recorder_imu="$work/imu.csv" --chunks-out "$work/replay.chunks" 2>"$work/replay.err" ||
     { cat "$work/replay.err" >&2; fail "replaying $work/dump.log failed"; }
   grep "chunks (" "$work/replay.err" || true
   "$tool_bin" chunks "$work/live.chunks" "$work/replay.chunks" ||

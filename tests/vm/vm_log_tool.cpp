@@ -5,6 +5,7 @@
 //   vm_log_tool generate OUT SECONDS           a synthetic can0 log (when no real log is there)
 //   vm_log_tool compare EXPECTED ACTUAL TIMED MAX_DRIFT NOW_WITHIN
 //   vm_log_tool chunks LIVE REPLAYED
+//   vm_log_tool aux-writer PIPE COPY SECONDS   (in the VM) a logger writing into a named pipe
 //
 // compare: ACTUAL (what dynid-socketcan-dump received) must hold the frames of EXPECTED in the
 // same order with identical id, format, FD flags, RTR, length and payload; its timestamps must be
@@ -16,7 +17,20 @@
 // chunks: two chunk files (dynid-car --chunks-out) must hold the same chunks: same count, and per
 // chunk the same ids, sequence, first sample index, dimensions, samples (bit for bit), validity
 // flags and checksum. Prints the first differences (at most 20) and the figures compared.
+//
+// aux-writer: an auxiliary logger for dynid-car's live --source (auxiliary_follower.hpp): opens
+// PIPE for writing (waiting for its reader), then every 10 ms for SECONDS writes a row
+// "t,ax,ay,az" with t the wall clock (the live bus's clock; 6 decimals) and ax = sin(t), to PIPE
+// and, line by line, to COPY (the file the host replays beside the dump). Ends on its own, or
+// when the reader has gone (the write fails).
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <csignal>
+#include <cerrno>
+#include <stdexcept>
+#include <thread>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -180,6 +194,34 @@ int compare_chunks(const std::string& live_path, const std::string& replayed_pat
   return problems == 0 && n > 0 ? 0 : 1;
 }
 
+int aux_writer(const std::string& pipe, const std::string& copy_path, double seconds) {
+  std::signal(SIGPIPE, SIG_IGN);  // a reader gone is the end, not a signal
+  const int out = ::open(pipe.c_str(), O_WRONLY | O_CLOEXEC);
+  if (out < 0) throw std::runtime_error(pipe + ": " + std::strerror(errno));
+  std::FILE* copy = std::fopen(copy_path.c_str(), "w");
+  if (copy == nullptr) throw std::runtime_error(copy_path + ": " + std::strerror(errno));
+  const std::string header = "t,ax,ay,az\n";
+  std::fputs(header.c_str(), copy);
+  std::fflush(copy);
+  if (::write(out, header.data(), header.size()) < 0) return 1;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  std::uint64_t rows = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    const double t = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+    char line[96];
+    const int n = std::snprintf(line, sizeof line, "%.6f,%.6f,0,9.81\n", t, std::sin(t));
+    std::fputs(line, copy);
+    std::fflush(copy);
+    if (::write(out, line, static_cast<std::size_t>(n)) != n) break;
+    ++rows;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::fclose(copy);
+  ::close(out);
+  std::cerr << "vm_log_tool aux-writer: " << rows << " rows\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -190,11 +232,13 @@ int main(int argc, char** argv) {
     if (a.size() == 6 && a[0] == "compare")
       return compare(a[1], a[2], std::stoul(a[3]), std::stod(a[4]), std::stod(a[5]));
     if (a.size() == 3 && a[0] == "chunks") return compare_chunks(a[1], a[2]);
+    if (a.size() == 4 && a[0] == "aux-writer") return aux_writer(a[1], a[2], std::stod(a[3]));
   } catch (const std::exception& e) {
     std::cerr << "vm_log_tool: " << e.what() << "\n";
     return 1;
   }
   std::cerr << "usage: vm_log_tool excerpt IN OUT SECONDS IFACE | generate OUT SECONDS |"
-               " compare EXPECTED ACTUAL TIMED MAX_DRIFT NOW_WITHIN | chunks LIVE REPLAYED\n";
+               " compare EXPECTED ACTUAL TIMED MAX_DRIFT NOW_WITHIN | chunks LIVE REPLAYED |"
+               " aux-writer PIPE COPY SECONDS\n";
   return 2;
 }

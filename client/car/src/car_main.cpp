@@ -47,6 +47,7 @@
 #include <dynid/input/option_checks.hpp>
 
 #include "dynid/car/auxiliary.hpp"
+#include "dynid/car/live_merge.hpp"
 #include "dynid/car/log_source.hpp"
 #include "dynid/car/chunk_file.hpp"
 #include "dynid/car/delivery.hpp"
@@ -150,7 +151,8 @@ RunSources run_profile(const Options& options) {
   }
   std::optional<LogSource> bus;
   if (!options.replay.empty()) bus.emplace(options.replay);
-  RunSources run = prepare_sources(declared, given, bus ? &*bus : nullptr);
+  const bool live = options.replay.empty() && !options.can.empty();
+  RunSources run = prepare_sources(declared, given, bus ? &*bus : nullptr, live);
   for (const auto& r : run.reports) {
     spdlog::info("{}", r.describe());
     for (const auto& w : r.warnings) spdlog::warn("source '{}': {}", r.name, w);
@@ -212,8 +214,12 @@ std::string replay_log(const Options& options, CarPipeline& pipe,
 // options.max_frames frames), then finishes it. `service` runs about every 100 ms
 // (acknowledgements, progress). Both the delivering client and --chunks-out read the bus
 // through this loop.
-void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe,
+void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe, std::vector<FollowedSource> followed,
               const std::function<void(const CarPipeline&)>& service) {
+  LiveMerge merge(pipe, std::move(followed), [](const std::string& stop) { spdlog::error("{}", stop); });
+  const auto wall_now = [] {  // the clock of the kernel's receive times
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  };
   g_live.store(&source);
   struct Unregister {
     ~Unregister() { g_live.store(nullptr); }
@@ -227,18 +233,22 @@ void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe
     if (status == NextStatus::End) break;
     if (status == NextStatus::Frame) {
       frame.timestamp = at_log_resolution(frame.timestamp);
-      pipe.on_frame(frame);
+      merge.on_frame(frame, wall_now());
       if (options.max_frames > 0 && source.frames() >= options.max_frames) break;
     }
     // No frame: the grid clock still moves (receive times are CLOCK_REALTIME), so rows leave.
-    if (status == NextStatus::Timeout)
-      pipe.idle(std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
+    if (status == NextStatus::Timeout) merge.idle(wall_now());
     if (std::chrono::steady_clock::now() >= next_service) {
+      merge.service(wall_now());
       service(pipe);
       next_service = std::chrono::steady_clock::now() + 100ms;
     }
   }
-  pipe.finish();
+  merge.finish(wall_now);
+  for (const auto& line : merge.report()) spdlog::info("{}", line);
+  if (merge.stats().frames_forced > 0)
+    spdlog::warn("{} frames let in at the end of a source's wait, a source behind them: the run's chunks may differ "
+                 "from a replay of the same files", merge.stats().frames_forced);
   log_auxiliary(pipe);
   spdlog::info("bus {} closed: {} frames, {} error frames, {} dropped by the kernel, {} chunks", options.can,
                source.frames(), source.error_frames(), source.dropped(), pipe.chunks());
@@ -248,6 +258,7 @@ struct Session {
   const Options& options;
   const VehicleProfile& profile;
   std::vector<AuxiliarySample> auxiliary;  // into the run's one pipeline
+  std::vector<FollowedSource> followed;    // live: the sources read while the bus is
   Spool& spool;
   Delivery& delivery;
   ProgressDisplay& display;
@@ -289,7 +300,7 @@ struct Session {
     CarPipeline pipe = pipeline(run);
     source_name = "live " + options.can;
     SocketCanSource source(options.can);
-    read_bus(options, source, pipe, [&](const CarPipeline& p) {
+    read_bus(options, source, pipe, std::move(followed), [&](const CarPipeline& p) {
       delivery.service(0ms);
       ReplayProgress progress;
       progress.frames = p.mapper_stats().frames;
@@ -367,7 +378,7 @@ int write_chunks(const Options& options) {
         if (g_stop.load()) throw Interrupted{};
       });
     } else {
-      read_bus(options, *live, pipe, [](const CarPipeline&) {});
+      read_bus(options, *live, pipe, std::move(sources.followed), [](const CarPipeline&) {});
     }
   } catch (const Interrupted&) {
     spdlog::warn("interrupted: {} chunks written to {}", writer.chunks(), options.chunks_out);
@@ -403,7 +414,7 @@ int run(const Options& options, ProgressDisplay& display) {
   });
 
 
-  Session session{options, profile, std::move(sources.samples), spool, delivery, display};
+  Session session{options, profile, std::move(sources.samples), std::move(sources.followed), spool, delivery, display};
   if (!options.replay.empty() || !options.can.empty()) session.read_source();
   const bool drained = session.drain();
   const auto& s = delivery.stats();

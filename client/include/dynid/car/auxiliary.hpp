@@ -17,7 +17,8 @@
 // Clock: bus time = source time + offset, the offset fixed in the profile or estimated
 // (clock_offset.hpp) from a channel of the source against a bus channel decoded from the
 // replayed log (the bus mapping, even where the source replaces it in the run). A live run has
-// no log to estimate from before it starts: an estimated clock is then an error. A clock that
+// no log to estimate from before it starts: an estimated clock is then an error; its CSV sources
+// are followed while they are written (auxiliary_follower.hpp, live_merge.hpp). A clock that
 // drifts (a significant slope of the offset along the run, clock_offset.hpp) is an error: a fixed
 // offset cannot align it.
 #include <cstddef>
@@ -27,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "dynid/car/auxiliary_follower.hpp"
 #include "dynid/car/clock_offset.hpp"
 #include "dynid/car/frame_source.hpp"
 #include "dynid/car/vehicle_profile.hpp"
@@ -60,6 +62,7 @@ struct SourceReport {
   double offset = 0.0;
   std::optional<ClockEstimate> estimate;
   std::size_t samples = 0;
+  bool followed = false;  ///< live: read as it is written (the merge reports its rows at the end)
   std::vector<std::string> warnings;
   std::string unmapped_columns;
   std::string describe() const;  ///< one line for the log
@@ -67,15 +70,19 @@ struct SourceReport {
 
 struct RunSources {
   VehicleProfile profile;  ///< the run's profile: the bus channels, those of the given sources
-  std::vector<AuxiliarySample> samples;  ///< sorted by time
+  std::vector<AuxiliarySample> samples;  ///< replay: every source's samples, sorted by time
+  std::vector<FollowedSource> followed;  ///< live: the CSV sources, followed as they are written
   std::vector<SourceReport> reports;
 };
 
 /// The run's profile and auxiliary samples. `given`: --source NAME=FILE (overrides the profile's
 /// file); a name the profile does not declare is an InputError. `bus`: the replayed log, read once
-/// from its start for estimated clocks (nullptr live). A declared source with no file is left
-/// out of the run (reported), its replaced bus channels staying on the bus.
+/// from its start for estimated clocks (nullptr: none). `live`: a live run, whose CSV sources are
+/// followed as they are written (auxiliary_follower.hpp, opened here, nothing read yet) and need
+/// a fixed clock offset; a CAN source is then an InputError (a second bus is read from its log,
+/// in a replay). A declared source with no file is left out of the run (reported), its replaced
+/// bus channels staying on the bus.
 RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::string, std::filesystem::path>& given,
-                           FrameSource* bus);
+                           FrameSource* bus, bool live = false);
 
 }  // namespace dynid::car

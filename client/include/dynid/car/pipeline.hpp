@@ -20,6 +20,7 @@
 // bus channel. Samples before the run's first frame, or after its last, are dropped and counted
 // (auxiliary_stats()).
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -46,6 +47,11 @@ class CarPipeline {
   void on_frame(const can::Frame& frame);
   /// Samples of the run's auxiliary channels, sorted by time (RunSources::samples).
   void add_auxiliary(std::vector<AuxiliarySample> samples);
+  /// More samples of a live run (live_merge.hpp), sorted by time, none before the last given
+  /// nor at or before newest_frame_time(): they join those given before.
+  void append_auxiliary(std::vector<AuxiliarySample> samples);
+  /// Source-clock time of the newest frame taken (-inf before the first).
+  double newest_frame_time() const { return first_time_ ? last_time_ : -std::numeric_limits<double>::infinity(); }
   /// Advances the grid clock to `time` (source clock) without a frame; a silence longer than
   /// the profile's max_time_jump ends the grid piece (resampler.hpp, Time jumps).
   void idle(double time);

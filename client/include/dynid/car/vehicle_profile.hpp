@@ -51,6 +51,8 @@
 //   time_unit = "s"                    # s, ms, us or ns
 //   clock = { offset = 0.0 }           # bus time = source time + offset (seconds), or
 //   clock = { estimate_from = "ax", reference = "ax", max_offset = 2.0, reference_derivative = false }
+//   wait = 1.0                         # live runs: seconds the bus may wait for this source's
+//                                      # rows (live_merge.hpp), at most 30
 //   [[sources.channels]]
 //   column = "ax"                      # a column of the header
 //   channel = "ax"                     # catalogue channel
@@ -164,8 +166,13 @@ struct AuxiliarySourceSpec {
   /// the order of `channels`), decoded as the main bus's are.
   std::shared_ptr<const VehicleProfile> bus;
   SourceClockRelation clock;
+  /// csv, live runs: seconds the bus may be held for this source's rows (live_merge.hpp)
+  double wait = 1.0;
   std::vector<SourceChannel> channels;
 };
+
+/// Longest [[sources]] wait: every frame of the bus may be held that long.
+inline constexpr double kMaxSourceWait = 30.0;
 
 struct VehicleProfile {
   std::filesystem::path source;  ///< the profile file (or the name given to parse)
