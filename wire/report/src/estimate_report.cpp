@@ -54,8 +54,10 @@ const char* status_name(ls::ParameterStatus status) {
 }
 
 std::string format_estimate_text(const dds::EstimateTable& t) {
-  std::string out = fmt::format("{} / {}  (source {}, revision {})\n", t.vehicle, t.model,
-                                t.source, t.revision);
+  // Revision 0: a table no publication carried (a reprocessing, a stored history).
+  std::string out = t.revision == 0
+                        ? fmt::format("{} / {}  (source {}, not published)\n", t.vehicle, t.model, t.source)
+                        : fmt::format("{} / {}  (source {}, revision {})\n", t.vehicle, t.model, t.source, t.revision);
   // A model the run does not excite: one line, no numbers that would read as estimates.
   if (!t.not_excited.empty())
     return out + fmt::format("  not excited by this run: {} ({} rows; --json has the numbers)\n",
