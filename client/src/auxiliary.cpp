@@ -168,7 +168,7 @@ std::vector<TimeSeries> read_source(const AuxiliarySourceSpec& spec, SourceRepor
 }  // namespace
 
 RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::string, std::filesystem::path>& given,
-                           FrameSource* bus, bool live) {
+                           FrameSource* bus, bool live, const LiveCanOpener& open_can) {
   for (const auto& [name, path] : given) {
     bool known = false;
     std::string names;
@@ -188,9 +188,9 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
     const auto it = given.find(spec.name);
     report.file = it != given.end() ? it->second : spec.file;
     if (!report.file.empty()) {
-      if (live && spec.type != "csv")
-        throw InputError("source '" + spec.name + "' (" + report.file.string() + "): a second CAN bus is read from its "
-                         "log, in a replay; a live run follows CSV sources (a file or named pipe being written)");
+      if (live && spec.type != "csv" && !open_can)
+        throw InputError("source '" + spec.name + "' (" + report.file.string() + "): a second CAN bus is read live "
+                         "only by dynid-car (its interface), else from its log in a replay");
       if (!live) series[si] = read_source(spec, report);
       if (spec.clock.offset) {
         report.offset = *spec.clock.offset;
@@ -238,7 +238,10 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
       if (run.profile.channels[c].source == si) column_of[run.profile.channels[c].source_channel] = c;
     if (live) {
       report.followed = true;
-      run.followed.push_back({std::make_unique<AuxiliaryFollower>(spec, report.file, report.offset), column_of, spec.wait});
+      std::unique_ptr<LiveSource> follower;
+      if (spec.type == "csv") follower = std::make_unique<AuxiliaryFollower>(spec, report.file, report.offset);
+      else follower = open_can(spec, report.file.string(), report.offset);
+      run.followed.push_back({std::move(follower), column_of, spec.wait});
       continue;
     }
     for (std::size_t ci = 0; ci < spec.channels.size(); ++ci)

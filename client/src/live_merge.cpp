@@ -30,7 +30,7 @@ void LiveMerge::read_sources() {
   for (std::size_t s = 0; s < sources_.size(); ++s)
     if (const auto& error = sources_[s].follower->error(); error && !stop_told_[s]) {
       stop_told_[s] = true;
-      if (on_stop_) on_stop_("source '" + sources_[s].follower->spec().name + "' stopped, its channels missing from here on: " + *error);
+      if (on_stop_) on_stop_("source '" + sources_[s].follower->name() + "' stopped, its channels missing from here on: " + *error);
     }
   stats_.late = 0;
   for (auto n : late_) stats_.late += n;
@@ -125,8 +125,8 @@ void LiveMerge::finish(const std::function<double()>& wall_clock) {
 std::vector<std::string> LiveMerge::report() const {
   std::vector<std::string> lines;
   for (std::size_t s = 0; s < sources_.size(); ++s) {
-    const AuxiliaryFollower& f = *sources_[s].follower;
-    std::string line = "source '" + f.spec().name + "' (" + f.file().string() + ", followed live): " +
+    const LiveSource& f = *sources_[s].follower;
+    std::string line = "source '" + f.name() + "' (" + f.origin() + ", followed live): " +
                        std::to_string(f.rows()) + " rows";
     if (late_[s] > 0)
       line += "; " + std::to_string(late_[s]) + " samples came more than its wait (" + std::to_string(sources_[s].wait) +

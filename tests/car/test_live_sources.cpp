@@ -284,7 +284,20 @@ TEST(LiveMerge, WithoutSourcesEveryFrameGoesStraightThrough) {
   EXPECT_EQ(merge.stats().frames_held, 0u);
 }
 
-TEST(LiveMerge, ALiveRunRefusesACanSourceAndAnEstimatedClock) {
+TEST(LiveMerge, ALiveRunRefusesACanSourceWithoutAnInterfaceOpenerAndAnEstimatedClock) {
+  const std::string chassis =
+      "[vehicle]\nid = \"aux-car\"\ndbc = \"" + kDbc +
+      "\"\n[grid]\nrate_hz = 100.0\nchunk_seconds = 1.0\n[spool]\ndirectory = \"spool\"\nmax_bytes = 1000000\n"
+      "[[channels]]\nname = \"vx\"\nmessage = \"ESP_Dynamics\"\nsignal = \"VehSpeed\"\n"
+      "[[sources]]\nname = \"chassis\"\ntype = \"can\"\ndbc = \"" + kDbc + "\"\nclock = { offset = 0.0 }\n"
+      "[[sources.channels]]\nname = \"yaw_rate\"\nmessage = \"ESP_Dynamics\"\nsignal = \"YawRate\"\n";
+  try {
+    (void)prepare_sources(parse_vehicle_profile(chassis, "aux.toml"), {{"chassis", "can1"}}, nullptr, true);
+    ADD_FAILURE() << "a CAN source live without an opener";
+  } catch (const InputError& e) {
+    EXPECT_HAS(std::string(e.what()), "only by dynid-car");
+  }
+
   DYNID_REQUIRE_RAV4_DATA();
   const VehicleProfile estimated = load_vehicle_profile(test::profile_path("rav4.toml"));
   const auto imu = test::rav4_data_dir() / "phone_imu_accel.csv";

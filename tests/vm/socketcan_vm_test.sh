@@ -7,8 +7,9 @@
 # timestamps (non-decreasing, wall-clock, paced like the log). Then: kernel filters, a time
 # limit on a silent bus and SIGTERM, each ending the dump cleanly.
 # Beside the dump, dynid-car reads the same frames live with the vehicle profile (--chunks-out),
-# and the recorder IMU from a named pipe a logger writes into (an auxiliary source followed live);
-# on this machine the dump and the logger's rows are replayed through the same pipeline
+# with two auxiliary sources followed live: the recorder IMU from a named pipe a logger writes
+# into, and a second bus with its own DBC on vcan1 (cangen's frames, dumped too); on this machine
+# the dumps and the logger's rows are replayed through the same pipeline
 # (--replay --source --chunks-out), and the two chunk files must be identical byte for byte: the
 # live path cuts exactly the chunks a replay of what it received cuts (the RAV4 log and DBC are
 # needed for this part).
@@ -49,6 +50,7 @@ readonly PLAYED_IFACE=can0
 readonly CAR_RUN=vm-live      # the same run id live and replayed: it is part of every chunk
 readonly CAR_GRACE=15         # s after the dump ended for dynid-car to reach the same frame count
 readonly AUX_SECONDS=30       # the IMU logger's longest life; it ends when dynid-car has
+readonly CHASSIS_FRAMES=300   # cangen's frames on vcan1, one per 10 ms, beside canplayer's
 
 as_root() {
   if [ "$(id -u)" -eq 0 ]; then "$@"
@@ -189,6 +191,24 @@ make_car_profile() {
     "$profile" >"$work/car/car.toml"
   grep -q '^interfaces = \["vcan0"\]' "$work/car/car.toml" || fail "$profile names no interfaces = [...]"
   grep -q '^wait = 5.0' "$work/car/car.toml" || fail "$profile: no [[sources]] clock = { estimate_from ... } line to fix"
+  # A second bus on vcan1 with its own DBC (the project's test car's), its yaw rate in place of
+  # the RAV4's: followed live on its interface, replayed from its dump.
+  cp "$(dirname "$profile")/../dbc/dynid_testcar.dbc" "$work/car/chassis.dbc" || fail "no dynid_testcar.dbc"
+  cat >>"$work/car/car.toml" <<'TOML'
+
+[[sources]]
+name = "chassis"
+type = "can"
+dbc = "chassis.dbc"
+interfaces = ["vcan1"]
+clock = { offset = 0.0 }
+
+[[sources.channels]]
+name = "yaw_rate"
+message = "ESP_Dynamics"
+signal = "YawRate"
+replaces_bus = true
+TOML
 }
 
 make_expected_log() {
@@ -203,7 +223,7 @@ write_init() {
     echo '#!/bin/busybox sh'
     echo "MODULES='${modules[*]}' EXPECTED=$expected PLAYED_IFACE=$PLAYED_IFACE"
     echo "ERROR_SEND='$ERROR_SEND' EXTRA_SEND='${EXTRA_SEND[*]}'"
-    echo "CAR_RUN=$CAR_RUN CAR_GRACE=$CAR_GRACE AUX_SECONDS=$AUX_SECONDS"
+    echo "CAR_RUN=$CAR_RUN CAR_GRACE=$CAR_GRACE AUX_SECONDS=$AUX_SECONDS CHASSIS_FRAMES=$CHASSIS_FRAMES"
     cat <<'INIT'
 /bin/busybox --install -s /bin
 # The firmware's "Booting from ROM.." ends without a newline on the serial console: end that line
@@ -215,7 +235,7 @@ vmfail() { echo "DYNID-VM-FAIL $*"; poweroff -f; }
 # Waits until the dump whose stderr goes to $1 has bound its socket.
 ready() {
   n=0
-  until grep -q "reading vcan0" "$1" 2>/dev/null; do
+  until grep -q "reading vcan" "$1" 2>/dev/null; do
     n=$((n + 1)); [ $n -gt 100 ] && { cat "$1"; vmfail "$1: reader did not start"; }
     sleep 0.1
   done
@@ -228,6 +248,7 @@ mount -t proc proc /proc && mount -t sysfs sysfs /sys && mount -t devtmpfs devtm
 for m in $MODULES; do insmod /lib/modules/$m.ko || vmfail "insmod $m"; done
 ip link add dev vcan0 type vcan && ip link set vcan0 mtu 72 && ip link set up vcan0 ||
   vmfail "vcan0"
+ip link add dev vcan1 type vcan && ip link set up vcan1 || vmfail "vcan1"
 
 # 1. The log, then the extra frames and an error frame; ends after EXPECTED frames. dynid-car
 #    reads them too, live, and writes its chunks; stopping at the same frame count (not on a
@@ -237,19 +258,28 @@ ip link add dev vcan0 type vcan && ip link set vcan0 mtu 72 && ip link set up vc
 dynid-socketcan-dump --frames $EXPECTED --seconds 60 --output /tmp/dump.log vcan0 \
   2>/tmp/dump.err &
 dump=$!
+dynid-socketcan-dump --frames $CHASSIS_FRAMES --seconds 60 --output /tmp/chassis.log vcan1 \
+  2>/tmp/chassis.err &
+chassis=$!
 mkfifo /tmp/imu.pipe || vmfail "mkfifo"
 dynid-car --profile /test/car/car.toml --run $CAR_RUN --can vcan0 --max-frames $EXPECTED \
-  --source recorder_imu=/tmp/imu.pipe --chunks-out /tmp/live.chunks 2>/tmp/car.err &
+  --source recorder_imu=/tmp/imu.pipe --source chassis=vcan1 --chunks-out /tmp/live.chunks \
+  2>/tmp/car.err &
 car=$!
 ready /tmp/dump.err
+ready /tmp/chassis.err
 ready /tmp/car.err
 vm_log_tool aux-writer /tmp/imu.pipe /tmp/imu.csv $AUX_SECONDS 2>/tmp/aux.err &
+cangen vcan1 -I 0B0 -L 8 -g 10 -n $CHASSIS_FRAMES || vmfail "cangen vcan1" &
 canplayer -I /test/input.log vcan0=$PLAYED_IFACE || vmfail "canplayer"
 cansend vcan0 $ERROR_SEND || vmfail "cansend $ERROR_SEND"
 for f in $EXTRA_SEND; do cansend vcan0 "$f" || vmfail "cansend $f"; done
 wait $dump
 echo "DYNID-DUMP-STATUS $?"
 cat /tmp/dump.err
+wait $chassis
+echo "DYNID-CHASSIS-STATUS $?"
+cat /tmp/chassis.err
 # A car that lost frames (kernel drops) never reaches EXPECTED: stop it rather than hang.
 (sleep $CAR_GRACE; kill -TERM $car 2>/dev/null) &
 wait $car
@@ -281,6 +311,7 @@ section FILTER /tmp/filter.log
 echo DYNID-CHUNKS-BEGIN; base64 /tmp/live.chunks; echo DYNID-CHUNKS-END
 cat /tmp/aux.err
 echo DYNID-IMU-BEGIN; base64 /tmp/imu.csv; echo DYNID-IMU-END
+section CHASSIS /tmp/chassis.log
 poweroff -f
 INIT
   } >"$root/init"
@@ -303,6 +334,7 @@ build_initramfs() {
   copy_program "$dump_bin" /opt/bin/dynid-socketcan-dump
   copy_program "$car_bin" /opt/bin/dynid-car
   copy_program "$tool_bin" /opt/bin/vm_log_tool
+  copy_program "$(command -v cangen)" /opt/bin/cangen
   cp -r "$work/car" "$root/test/car"
   cp "$work/input.log" "$root/test/input.log"
   write_init
@@ -363,13 +395,18 @@ check_chunks() {
   grep -q "^DYNID-CHUNKS-END" "$work/serial.txt" || fail "no live chunks on the serial console"
   section CHUNKS | base64 -d >"$work/live.chunks" || fail "the live chunks did not decode from base64"
   section IMU | base64 -d >"$work/imu.csv" || fail "the IMU logger's copy did not decode from base64"
-  grep -E "followed live\): [1-9][0-9]* rows" "$work/serial.txt" ||
+  section CHASSIS >"$work/chassis.log"
+  grep -q "^DYNID-CHASSIS-STATUS 0$" "$work/serial.txt" || fail "the dump of vcan1 failed in the VM"
+  grep -E "source 'recorder_imu' .*followed live\): [1-9][0-9]* rows" "$work/serial.txt" ||
     fail "dynid-car read no row of the IMU it followed live"
+  grep -E "source 'chassis' \(vcan1, followed live\): [1-9][0-9]* rows" "$work/serial.txt" ||
+    fail "dynid-car read no row of the second bus it followed live on vcan1"
   grep -q "samples merged into the grid" "$work/serial.txt" || fail "no IMU sample merged live"
   ! grep -q "frames let in at the end of a source's wait" "$work/serial.txt" ||
     fail "the live bus outran its IMU source's wait: the comparison below cannot hold"
   "$car_bin" --profile "$work/car/car.toml" --run "$CAR_RUN" --replay "$work/dump.log" --fast \
-    --source recorder_imu="$work/imu.csv" --chunks-out "$work/replay.chunks" 2>"$work/replay.err" ||
+    --source recorder_imu="$work/imu.csv" --source chassis="$work/chassis.log" \
+    --chunks-out "$work/replay.chunks" 2>"$work/replay.err" ||
     { cat "$work/replay.err" >&2; fail "replaying $work/dump.log failed"; }
   grep "chunks (" "$work/replay.err" || true
   "$tool_bin" chunks "$work/live.chunks" "$work/replay.chunks" ||

@@ -11,7 +11,9 @@
 #include <cstdio>
 #include <string>
 
+#include <dynid/car/can_interface_follower.hpp>
 #include <dynid/car/socketcan_source.hpp>
+#include <dynid/car/vehicle_profile.hpp>
 
 namespace dynid::car {
 namespace {
@@ -55,6 +57,26 @@ TEST(SocketCanSource, KernelWithCanNamesMissingInterface) {
   EXPECT_EQ(e.error_number(), ENODEV);
   EXPECT_TRUE(contains(e.what(), "dynidnosuch0")) << e.what();
   EXPECT_TRUE(contains(e.what(), "(ENODEV)")) << e.what();
+}
+
+// A second bus followed live (--source chassis=IFACE) opens its interface before the run: an
+// interface this kernel cannot give is the same SocketCanError, naming it, before any state.
+TEST(CanInterfaceFollower, AnInterfaceThatCannotBeOpenedIsRefusedBeforeTheRun) {
+  const std::string text =
+      "[vehicle]\nid = \"aux-car\"\ndbc = \"" + std::string(DYNID_SOURCE_DIR) +
+      "/deploy/dbc/dynid_testcar.dbc\"\n[grid]\nrate_hz = 100.0\nchunk_seconds = 1.0\n[spool]\n"
+      "directory = \"spool\"\nmax_bytes = 1000000\n[[channels]]\nname = \"vx\"\nmessage = \"ESP_Dynamics\"\n"
+      "signal = \"VehSpeed\"\n[[sources]]\nname = \"chassis\"\ntype = \"can\"\ndbc = \"" +
+      std::string(DYNID_SOURCE_DIR) + "/deploy/dbc/dynid_testcar.dbc\"\nclock = { offset = 0.0 }\n"
+      "[[sources.channels]]\nname = \"yaw_rate\"\nmessage = \"ESP_Dynamics\"\nsignal = \"YawRate\"\n";
+  const VehicleProfile profile = parse_vehicle_profile(text, "aux.toml");
+  try {
+    CanInterfaceFollower follower(profile.sources.at(0), "dynidnosuch1", 0.0);
+    ADD_FAILURE() << "opened an interface that does not exist";
+  } catch (const SocketCanError& e) {
+    EXPECT_EQ(e.interface_name(), "dynidnosuch1");
+    EXPECT_TRUE(e.error_number() == ENODEV || e.error_number() == EAFNOSUPPORT) << e.what();
+  }
 }
 
 TEST(SocketCanSource, AnyKernelGivesSocketCanErrorForAMissingInterface) {

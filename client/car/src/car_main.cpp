@@ -49,6 +49,7 @@
 #include "dynid/car/auxiliary.hpp"
 #include "dynid/car/live_merge.hpp"
 #include "dynid/car/log_source.hpp"
+#include "dynid/car/can_interface_follower.hpp"
 #include "dynid/car/chunk_file.hpp"
 #include "dynid/car/delivery.hpp"
 #include "dynid/car/pipeline.hpp"
@@ -127,16 +128,6 @@ void check_new_run(const Spool& spool, const std::string& vehicle, const std::st
                             " (its unacknowledged chunks are resent automatically): choose a new --run");
 }
 
-// Live timestamps at the resolution of a candump -l log (whole microseconds; the kernel gives
-// nanoseconds): a log recorded beside the live reader then replays to the very same chunks, bit
-// for bit (the resampler interpolates, so a 0.4 us difference would change the samples' low
-// bits). A microsecond is far below a CAN frame's own duration (>= 47 us at 1 Mbit/s), and a
-// double of epoch seconds resolves only ~0.24 us anyway. micros / 1e6 is the nearest double to
-// the decimal the log holds, the same value CandumpSource parses from it.
-double at_log_resolution(double seconds) {
-  return static_cast<double>(std::llround(seconds * 1e6)) / 1e6;
-}
-
 // The profile of this run: the declared one with the auxiliary sources given (auxiliary.hpp),
 // their clocks put on the bus's (an estimate reads the replayed log once), reported.
 RunSources run_profile(const Options& options) {
@@ -152,7 +143,11 @@ RunSources run_profile(const Options& options) {
   std::optional<LogSource> bus;
   if (!options.replay.empty()) bus.emplace(options.replay);
   const bool live = options.replay.empty() && !options.can.empty();
-  RunSources run = prepare_sources(declared, given, bus ? &*bus : nullptr, live);
+  // A second bus live: its interface, given in place of a log (--source chassis=can1).
+  const LiveCanOpener open_can = [](const AuxiliarySourceSpec& spec, const std::string& interface, double offset) {
+    return std::make_unique<CanInterfaceFollower>(spec, interface, offset);
+  };
+  RunSources run = prepare_sources(declared, given, bus ? &*bus : nullptr, live, open_can);
   for (const auto& r : run.reports) {
     spdlog::info("{}", r.describe());
     for (const auto& w : r.warnings) spdlog::warn("source '{}': {}", r.name, w);
@@ -232,7 +227,7 @@ void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe
     const NextStatus status = source.next(frame, 100ms);
     if (status == NextStatus::End) break;
     if (status == NextStatus::Frame) {
-      frame.timestamp = at_log_resolution(frame.timestamp);
+      frame.timestamp = live_timestamp(frame.timestamp);
       merge.on_frame(frame, wall_now());
       if (options.max_frames > 0 && source.frames() >= options.max_frames) break;
     }

@@ -17,12 +17,13 @@
 // Clock: bus time = source time + offset, the offset fixed in the profile or estimated
 // (clock_offset.hpp) from a channel of the source against a bus channel decoded from the
 // replayed log (the bus mapping, even where the source replaces it in the run). A live run has
-// no log to estimate from before it starts: an estimated clock is then an error; its CSV sources
-// are followed while they are written (auxiliary_follower.hpp, live_merge.hpp). A clock that
+// no log to estimate from before it starts: an estimated clock is then an error; its sources are
+// followed while they are written (live_source.hpp, live_merge.hpp). A clock that
 // drifts (a significant slope of the offset along the run, clock_offset.hpp) is an error: a fixed
 // offset cannot align it.
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -71,18 +72,23 @@ struct SourceReport {
 struct RunSources {
   VehicleProfile profile;  ///< the run's profile: the bus channels, those of the given sources
   std::vector<AuxiliarySample> samples;  ///< replay: every source's samples, sorted by time
-  std::vector<FollowedSource> followed;  ///< live: the CSV sources, followed as they are written
+  std::vector<FollowedSource> followed;  ///< live: every given source, followed as it is written
   std::vector<SourceReport> reports;
 };
 
+/// Opens a CAN source live on an interface (given as its --source NAME=INTERFACE); dynid-car
+/// gives one (client/socketcan, can_interface_follower.hpp).
+using LiveCanOpener =
+    std::function<std::unique_ptr<LiveSource>(const AuxiliarySourceSpec&, const std::string& interface, double offset)>;
+
 /// The run's profile and auxiliary samples. `given`: --source NAME=FILE (overrides the profile's
 /// file); a name the profile does not declare is an InputError. `bus`: the replayed log, read once
-/// from its start for estimated clocks (nullptr: none). `live`: a live run, whose CSV sources are
-/// followed as they are written (auxiliary_follower.hpp, opened here, nothing read yet) and need
-/// a fixed clock offset; a CAN source is then an InputError (a second bus is read from its log,
-/// in a replay). A declared source with no file is left out of the run (reported), its replaced
-/// bus channels staying on the bus.
+/// from its start for estimated clocks (nullptr: none). `live`: a live run, whose sources are
+/// followed as they are written (live_source.hpp; opened here, nothing read yet) and need a fixed
+/// clock offset: a CSV source's file (auxiliary_follower.hpp), a CAN source's interface given in
+/// place of its log, opened by `open_can` (none: an InputError). A declared source with no file
+/// is left out of the run (reported), its replaced bus channels staying on the bus.
 RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::string, std::filesystem::path>& given,
-                           FrameSource* bus, bool live = false);
+                           FrameSource* bus, bool live = false, const LiveCanOpener& open_can = {});
 
 }  // namespace dynid::car

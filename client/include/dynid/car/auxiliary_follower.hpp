@@ -27,29 +27,32 @@
 #include <vector>
 
 #include "dynid/car/auxiliary_csv.hpp"
+#include "dynid/car/live_source.hpp"
 #include "dynid/car/vehicle_profile.hpp"
 
 namespace dynid::car {
 
-class AuxiliaryFollower {
+class AuxiliaryFollower final : public LiveSource {
  public:
   static constexpr std::size_t kMaxBytesPerPoll = 1u << 20;
   static constexpr std::size_t kMaxLineBytes = 1u << 16;
 
   /// `offset`: bus time = source time + offset.
   AuxiliaryFollower(const AuxiliarySourceSpec& spec, std::filesystem::path file, double offset);
-  ~AuxiliaryFollower();
+  ~AuxiliaryFollower() override;
   AuxiliaryFollower(const AuxiliaryFollower&) = delete;
   AuxiliaryFollower& operator=(const AuxiliaryFollower&) = delete;
 
-  std::vector<AuxiliaryRow> poll();
+  std::vector<AuxiliaryRow> poll() override;
 
-  double complete_until() const;
-  bool ended() const { return ended_; }
-  const std::optional<std::string>& error() const { return error_; }
+  double complete_until() const override;
+  bool ended() const override { return ended_; }
+  const std::optional<std::string>& error() const override { return error_; }
+  const std::string& name() const override { return spec_.name; }
+  std::string origin() const override { return file_.string(); }
+  std::uint64_t rows() const override { return rows_; }
   const AuxiliarySourceSpec& spec() const { return spec_; }
   const std::filesystem::path& file() const { return file_; }
-  std::uint64_t rows() const { return rows_; }
   const AuxiliaryCsvParser& parser() const { return parser_; }
 
  private:
@@ -71,9 +74,10 @@ class AuxiliaryFollower {
   void stop(std::string reason);
 };
 
-/// A followed source and where its channels sit in the run's profile.
+/// A source followed live (a file, a pipe, an interface) and where its channels sit in the
+/// run's profile.
 struct FollowedSource {
-  std::unique_ptr<AuxiliaryFollower> follower;
+  std::unique_ptr<LiveSource> follower;
   std::vector<std::size_t> column_of;  ///< per declared channel: its column in the run's profile
   double wait = 1.0;                   ///< seconds the bus may be held for it ([[sources]] wait)
 };

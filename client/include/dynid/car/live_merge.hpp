@@ -1,5 +1,5 @@
 #pragma once
-// LiveMerge: the live bus and the auxiliary sources followed beside it (auxiliary_follower.hpp)
+// LiveMerge: the live bus and the auxiliary sources followed beside it (live_source.hpp)
 // into one CarPipeline, so that a live run cuts the chunks a replay of the same frames and the
 // same source files cuts (pipeline.hpp merges whole sources there), as long as every source keeps
 // up with the bus within its wait.
@@ -7,7 +7,7 @@
 // Why hold the bus: the pipeline merges, before each frame, every auxiliary sample up to the
 // frame's time. A writer's rows reach us later than the frames of the same instant (a logger
 // writes in blocks, a pipe buffers), so a frame at bus time t is held until every source has been
-// read up to t (AuxiliaryFollower::complete_until), or until `now` (the wall clock, which is the
+// read up to t (LiveSource::complete_until), or until `now` (the wall clock, which is the
 // live bus's clock) passes t + that source's wait ([[sources]] wait, VehicleProfile). A held
 // frame then goes in with the source's samples up to its time, in the order a replay gives them
 // (time, then source, then channel). A row of a source that arrives after the bus was let past

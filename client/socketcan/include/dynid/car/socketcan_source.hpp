@@ -17,6 +17,7 @@
 //   called from any thread or a SIGINT handler (it wakes a next() waiting in poll()).
 // - Not copyable or movable (request_stop() may be called from a handler that holds a pointer).
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <cstdint>
 #include <string>
@@ -29,6 +30,16 @@
 #include "dynid/car/socketcan_error.hpp"
 
 namespace dynid::car {
+
+/// A kernel receive time at the resolution of a candump -l log (whole microseconds; the kernel
+/// gives nanoseconds): a log recorded beside the live reader then replays to the very same
+/// chunks, bit for bit (the resampler interpolates, so a 0.4 us difference would change the
+/// samples' low bits). A microsecond is far below a CAN frame's own duration (>= 47 us at
+/// 1 Mbit/s), and a double of epoch seconds resolves only ~0.24 us anyway. micros / 1e6 is the
+/// nearest double to the decimal the log holds, the value the log readers parse from it.
+inline double live_timestamp(double kernel_seconds) {
+  return static_cast<double>(std::llround(kernel_seconds * 1e6)) / 1e6;
+}
 
 /// Kernel-side acceptance filter: a frame passes when its extended flag equals `extended` and
 /// (frame id & mask) == (id & mask); `inverted` passes exactly the frames that would not.
