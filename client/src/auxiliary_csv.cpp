@@ -6,6 +6,7 @@
 #include <dynid/input/ids.hpp>
 #include <dynid/input/number.hpp>
 
+#include "dynid/car/ecef.hpp"
 #include "dynid/error.hpp"
 
 namespace dynid::car {
@@ -49,7 +50,12 @@ void AuxiliaryCsvParser::read_header(std::string_view text) {
   for (auto c : cells(text)) header_.emplace_back(c);
   try {
     time_column_ = column(spec_.time_column);
-    for (const auto& c : spec_.channels) columns_.push_back(column(c.column));
+    for (const auto& c : spec_.channels) columns_.push_back(c.derived.empty() ? column(c.column) : 0);
+    if (spec_.ecef)
+      for (std::size_t i = 0; i < 3; ++i) {
+        ecef_[i] = column(spec_.ecef->position[i]);
+        ecef_[3 + i] = column(spec_.ecef->velocity[i]);
+      }
   } catch (...) {  // nothing taken: the parser is as it was
     header_.clear();
     columns_.clear();
@@ -87,6 +93,10 @@ std::optional<AuxiliaryRow> AuxiliaryCsvParser::line(std::string_view text) {
   AuxiliaryRow out{seconds, std::vector<double>(columns_.size(), std::numeric_limits<double>::quiet_NaN())};
   std::size_t non_finite = 0;
   for (std::size_t j = 0; j < columns_.size(); ++j) {
+    if (!spec_.channels[j].derived.empty()) {
+      out.values[j] = derived(spec_.channels[j].derived, row);
+      continue;
+    }
     const std::string_view cell = row[columns_[j]];
     if (cell.empty()) continue;
     if (is_non_finite_word(cell)) {
@@ -106,8 +116,25 @@ std::optional<AuxiliaryRow> AuxiliaryCsvParser::line(std::string_view text) {
   return out;
 }
 
+// The ECEF cells of the row (NaN where one is empty or not a number: no derived value).
+double AuxiliaryCsvParser::derived(const std::string& quantity, const std::vector<std::string_view>& row) const {
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  std::array<double, 6> v{};
+  for (std::size_t i = 0; i < 6; ++i) {
+    const auto x = input::parse_finite(row[ecef_[i]]);
+    if (!x) return kNone;
+    v[i] = *x;
+  }
+  const Vec3 position{v[0], v[1], v[2]}, velocity{v[3], v[4], v[5]};
+  if (quantity == "speed") return path_speed(velocity);
+  return path_grade(position, velocity).value_or(kNone);
+}
+
 std::string AuxiliaryCsvParser::unmapped_columns() const {
-  std::set<std::size_t> used(columns_.begin(), columns_.end());
+  std::set<std::size_t> used;
+  for (std::size_t j = 0; j < columns_.size(); ++j)
+    if (spec_.channels[j].derived.empty()) used.insert(columns_[j]);
+  if (spec_.ecef) used.insert(ecef_.begin(), ecef_.end());
   used.insert(time_column_);
   std::string ignored;
   for (std::size_t i = 0; i < header_.size(); ++i)

@@ -336,13 +336,32 @@ bool read_bool(const Reader& r, const toml::table& t, const std::string& name, c
 
 SourceChannel read_source_channel(const Reader& r, const VehicleProfile& p, const toml::table& t,
                                   const std::string& key) {
-  r.only_keys(t, {"column", "channel", "unit", "scale", "sign", "max_gap", "replaces_bus"}, key + ".");
+  r.only_keys(t, {"column", "derived", "channel", "unit", "scale", "sign", "max_gap", "replaces_bus"}, key + ".");
   SourceChannel c;
-  c.column = r.string(t, "column", key + ".column");
   c.channel = r.string(t, "channel", key + ".channel");
   const auto unit = model::channel_unit(c.channel);
   if (!unit) r.fail(key + ".channel", "unknown channel '" + c.channel + "' (see docs/CHANNELS.md)", t.get("channel"));
   c.unit = *unit;
+  if (t.contains("derived")) {  // a quantity of the source's ECEF pose, in SI already
+    if (t.contains("column") || t.contains("unit"))
+      r.fail(key + ".derived", "a derived channel has no column and no unit", t.get("derived"));
+    c.derived = r.string(t, "derived", key + ".derived");
+    const char* derived_unit = c.derived == "grade" ? "rad" : c.derived == "speed" ? "m/s" : nullptr;
+    if (derived_unit == nullptr)
+      r.fail(key + ".derived", "unknown derived quantity '" + c.derived + "' (\"grade\" or \"speed\")", t.get("derived"));
+    if (c.unit != derived_unit)
+      r.fail(key + ".channel", "the " + c.derived + " is in " + derived_unit + ", channel '" + c.channel + "' in " + c.unit,
+             t.get("channel"));
+    c.column = c.derived;
+    c.given_unit = c.unit;
+    c.to_si = *conversion(c.unit, c.unit);
+    if (const toml::node* s = t.get("scale")) c.gain *= gain_term(r, p, *s, key + ".scale");
+    c.gain *= read_sign(r, t, key);
+    if (t.contains("max_gap")) c.max_gap = r.at_most(t, "max_gap", key + ".max_gap", kMaxSeconds);
+    c.replaces_bus = read_bool(r, t, "replaces_bus", key);
+    return c;
+  }
+  c.column = r.string(t, "column", key + ".column");
   if (!t.contains("unit"))
     r.fail(key + ".unit", "missing unit: give the unit of column '" + c.column + "' (channel '" + c.channel +
                               "' is in '" + c.unit + "'; \"-\" for a unitless column)");
@@ -357,6 +376,29 @@ SourceChannel read_source_channel(const Reader& r, const VehicleProfile& p, cons
   if (t.contains("max_gap")) c.max_gap = r.at_most(t, "max_gap", key + ".max_gap", kMaxSeconds);
   c.replaces_bus = read_bool(r, t, "replaces_bus", key);
   return c;
+}
+
+// ecef = { position = ["x", "y", "z"], velocity = ["vx", "vy", "vz"] }: three column names each.
+AuxiliarySourceSpec::Ecef read_ecef(const Reader& r, const toml::table& src, const std::string& key) {
+  const toml::node* n = src.get("ecef");
+  if (!n->is_table()) r.fail(key + ".ecef", "expected a table { position = [...], velocity = [...] }", n);
+  const toml::table& t = *n->as_table();
+  r.only_keys(t, {"position", "velocity"}, key + ".ecef.");
+  AuxiliarySourceSpec::Ecef e;
+  const auto three = [&](const char* name, std::array<std::string, 3>& out) {
+    const toml::node* a = t.get(name);
+    const toml::array* arr = a == nullptr ? nullptr : a->as_array();
+    if (arr == nullptr || arr->size() != 3)
+      r.fail(key + ".ecef." + name, "expected three column names (x, y, z)", a);
+    for (std::size_t i = 0; i < 3; ++i) {
+      const auto v = arr->get(i)->value<std::string>();
+      if (!v) r.fail(key + ".ecef." + name, "expected three column names (x, y, z)", a);
+      out[i] = *v;
+    }
+  };
+  three("position", e.position);
+  three("velocity", e.velocity);
+  return e;
 }
 
 SourceClockRelation read_clock(const Reader& r, const toml::table& src, const std::string& key) {
@@ -395,7 +437,7 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
     if (s.type != "csv" && s.type != "can")
       r.fail(key + ".type", "unknown source type '" + s.type + "' (\"csv\" or \"can\")", t.get("type"));
     if (s.type == "csv")
-      r.only_keys(t, {"name", "type", "file", "time_column", "time_unit", "clock", "wait", "channels"}, key + ".");
+      r.only_keys(t, {"name", "type", "file", "time_column", "time_unit", "clock", "wait", "ecef", "channels"}, key + ".");
     else
       r.only_keys(t, {"name", "type", "file", "dbc", "interfaces", "clock", "channels"}, key + ".");
     s.name = r.string(t, "name", key + ".name");
@@ -412,6 +454,7 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
       else if (unit == "us") s.time_scale = 1e-6;
       else if (unit == "ns") s.time_scale = 1e-9;
       else r.fail(key + ".time_unit", "expected \"s\", \"ms\", \"us\" or \"ns\"", t.get("time_unit"));
+      if (t.contains("ecef")) s.ecef = read_ecef(r, t, key);
     } else {
       bus = std::make_shared<VehicleProfile>();
       bus->source = p.source;
@@ -453,6 +496,10 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
       s.channels.push_back(std::move(c));
     }
     s.bus = bus;
+    for (const auto& c : s.channels)
+      if (!c.derived.empty() && !s.ecef)
+        r.fail(key + ".ecef", "channel '" + c.channel + "' is derived (" + c.derived +
+                                  "): give the ECEF columns, ecef = { position = [...], velocity = [...] }");
     if (!s.clock.offset) {
       bool mine = false;
       for (const auto& c : s.channels) mine = mine || c.channel == s.clock.estimate_from;

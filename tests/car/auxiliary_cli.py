@@ -45,7 +45,7 @@ cases = [
      ["unsorted.csv:102: time", "the rows must be sorted by time"]),
     ("unknown column", ["recorder_imu=" + variant("nocol.csv", ["t,accel_x,ay,az"] + body)], 1,
      ["nocol.csv:1: auxiliary source 'recorder_imu': no column 'ax' in the header (columns: t, accel_x, ay, az)"]),
-    ("undeclared source", ["gnss=" + imu], 1, ["declares no source 'gnss' (declared: recorder_imu)"]),
+    ("undeclared source", ["gnss=" + imu], 1, ["declares no source 'gnss' (declared: recorder_imu, gnss_pose)"]),
 ]
 failed = 0
 for name, sources, status, words in cases:

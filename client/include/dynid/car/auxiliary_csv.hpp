@@ -3,10 +3,13 @@
 // one at a time, so that a whole file (read_auxiliary_csv) and a file that grows while the run is
 // live (auxiliary_follower.hpp) are read by the same rules.
 //
-// Contract: the first line given is the header; every later line is a row. A line that breaks
+// Contract: the first line given is the header; every later line is a row. A derived channel
+// (a source with ECEF columns, vehicle_profile.hpp) is computed per row from the position and
+// velocity cells (ecef.hpp), in SI; a row missing one of them has no value for it. A line that breaks
 // a rule throws InputError "<where>:<line>: <reason>" and leaves the parser as it was (a caller
 // that stops there keeps everything before). Rows repeating the previous row's time give no
 // row (counted: repeated()); a "nan"/"inf" cell is a missing sample (counted: non_finite()).
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -44,13 +47,15 @@ class AuxiliaryCsvParser {
   std::string where_;
   std::vector<std::string> header_;
   std::size_t time_column_ = 0;
-  std::vector<std::size_t> columns_;  // per declared channel
+  std::vector<std::size_t> columns_;  // per declared channel (derived: unused)
+  std::array<std::size_t, 6> ecef_{};  // position x y z, velocity x y z
   std::optional<double> last_time_;
   std::size_t line_no_ = 0;
   std::size_t repeated_ = 0;
   std::size_t non_finite_ = 0;
 
   void read_header(std::string_view text);
+  double derived(const std::string& quantity, const std::vector<std::string_view>& row) const;
   std::size_t column(const std::string& name) const;
 };
 

@@ -59,6 +59,11 @@
 //   unit = "m/s^2"                     # required: the column's unit, converted to the channel's
 //   # optional: scale, sign = -1, max_gap (as for bus channels), replaces_bus = true (the bus
 //   # mapping of this channel gives way when the source is given for a run)
+//   # A GNSS/INS pose in ECEF (WGS84) gives derived channels (ecef.hpp):
+//   ecef = { position = ["x", "y", "z"], velocity = ["vx", "vy", "vz"] }   # m and m/s columns
+//   [[sources.channels]]
+//   derived = "grade"                  # the path's slope (rad; none below 1 m/s), or "speed" (m/s)
+//   channel = "road_grade"             # a channel of that unit; no column, no unit
 //   [[sources]]                        # a second CAN log (candump, ASC, BLF) with its own DBC
 //   name = "chassis"
 //   type = "can"
@@ -88,6 +93,7 @@
 // or with one of another quantity, a channel given by two sources, a bus channel given by a
 // source without replaces_bus, a clock that is neither an offset nor an estimate from a channel
 // of the source against a bus channel.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -135,7 +141,8 @@ struct ChannelMapping {
 
 /// One column of an auxiliary source mapped to a catalogue channel.
 struct SourceChannel {
-  std::string column;
+  std::string column;          ///< the header's column; for a derived channel, its quantity
+  std::string derived;         ///< "" (a column), "grade" or "speed" (from the source's ECEF pose)
   std::string channel;
   std::string unit;            ///< the catalogue's SI unit
   std::string given_unit;      ///< the column's unit as the profile gives it
@@ -162,6 +169,12 @@ struct AuxiliarySourceSpec {
   std::filesystem::path file;     ///< empty: given per run (--source NAME=FILE)
   std::string time_column;        ///< csv
   double time_scale = 1.0;        ///< csv: source time unit -> seconds
+  /// csv: ECEF position (m) and velocity (m/s) columns, x y z, for derived channels
+  struct Ecef {
+    std::array<std::string, 3> position;
+    std::array<std::string, 3> velocity;
+  };
+  std::optional<Ecef> ecef;
   /// can: a second bus's log with its own DBC: the DBC, interfaces and channel mappings (in
   /// the order of `channels`), decoded as the main bus's are.
   std::shared_ptr<const VehicleProfile> bus;
