@@ -16,7 +16,8 @@ LiveMerge::LiveMerge(CarPipeline& pipe, std::vector<FollowedSource> sources,
       late_(sources_.size(), 0),
       stop_told_(sources_.size(), false),
       on_stop_(std::move(on_stop)),
-      let_in_until_(-std::numeric_limits<double>::infinity()) {}
+      let_in_until_(-std::numeric_limits<double>::infinity()),
+      last_read_(-std::numeric_limits<double>::infinity()) {}
 
 void LiveMerge::read_sources() {
   for (std::size_t s = 0; s < sources_.size(); ++s)
@@ -84,19 +85,25 @@ void LiveMerge::on_frame(const can::Frame& frame, double now) {
     pipe_.on_frame(frame);
     return;
   }
-  read_sources();
+  // What was read already may suffice: a source complete up to the frame's time has given
+  // every row at or before it.
   if (held_.empty() && may_go_in(frame.timestamp, now)) {
     let_in(frame);
     return;
   }
   ++stats_.frames_held;
   held_.push_back(frame);
+  if (now - last_read_ >= kReadInterval) {
+    read_sources();
+    last_read_ = now;
+  }
   release(now);
 }
 
 void LiveMerge::service(double now) {
   if (sources_.empty()) return;
   read_sources();
+  last_read_ = now;
   release(now);
 }
 

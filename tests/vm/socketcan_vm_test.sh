@@ -249,6 +249,8 @@ for m in $MODULES; do insmod /lib/modules/$m.ko || vmfail "insmod $m"; done
 ip link add dev vcan0 type vcan && ip link set vcan0 mtu 72 && ip link set up vcan0 ||
   vmfail "vcan0"
 ip link add dev vcan1 type vcan && ip link set up vcan1 || vmfail "vcan1"
+# As on a car: dynid-car asks for 8 MiB of receive buffer, which the kernel caps at rmem_max.
+echo 8388608 >/proc/sys/net/core/rmem_max || vmfail "rmem_max"
 
 # 1. The log, then the extra frames and an error frame; ends after EXPECTED frames. dynid-car
 #    reads them too, live, and writes its chunks; stopping at the same frame count (not on a
@@ -364,7 +366,7 @@ run_vm() {
   kernel=$(ls "$kernel_root"/boot/vmlinuz-* | head -1)
   say "booting $(basename "$kernel") under qemu (TCG, -nic none, at most $QEMU_SECONDS s)"
   local start=$SECONDS rc=0
-  timeout "$QEMU_SECONDS" qemu-system-x86_64 -m 512 -nographic -no-reboot -nic none \
+  timeout "$QEMU_SECONDS" qemu-system-x86_64 -m 512 -smp 2 -accel tcg,thread=multi -nographic -no-reboot -nic none \
     -kernel "$kernel" -initrd "$work/initrd.gz" -append "console=ttyS0 quiet panic=-1" \
     </dev/null >"$work/serial.log" 2>&1 || rc=$?
   # Without the carriage returns and the terminal escapes the firmware writes.

@@ -128,6 +128,16 @@ void check_new_run(const Spool& spool, const std::string& vehicle, const std::st
                             " (its unacknowledged chunks are resent automatically): choose a new --run");
 }
 
+// The live bus's socket asks for a receive buffer of several seconds of a busy bus, so that a
+// moment behind (a slow disk, a scheduler hiccup, the bus held for an auxiliary source) costs no
+// frame; the kernel caps it at net.core.rmem_max (212992 bytes by default: ~250 frames; raise it
+// with sysctl on the car: docs/DESIGN.md, "Auxiliary sources in a live run"). Drops are counted.
+SocketCanOptions live_bus_options() {
+  SocketCanOptions o;
+  o.receive_buffer_bytes = 8 << 20;
+  return o;
+}
+
 // The profile of this run: the declared one with the auxiliary sources given (auxiliary.hpp),
 // their clocks put on the bus's (an estimate reads the replayed log once), reported.
 RunSources run_profile(const Options& options) {
@@ -294,7 +304,7 @@ struct Session {
   void read_bus_run(const std::string& run) {
     CarPipeline pipe = pipeline(run);
     source_name = "live " + options.can;
-    SocketCanSource source(options.can);
+    SocketCanSource source(options.can, live_bus_options());
     read_bus(options, source, pipe, std::move(followed), [&](const CarPipeline& p) {
       delivery.service(0ms);
       ReplayProgress progress;
@@ -359,7 +369,7 @@ int write_chunks(const Options& options) {
   if (!options.replay.empty()) probe_log(options, profile);
   // The source is opened before the chunk file is created: a bus that cannot be read leaves none.
   std::optional<SocketCanSource> live;
-  if (options.replay.empty()) live.emplace(options.can);
+  if (options.replay.empty()) live.emplace(options.can, live_bus_options());
   const std::string run = options.run.empty() ? default_run_id() : options.run;
   ChunkFileWriter writer(options.chunks_out);
   CarPipeline pipe(profile, run, [&writer](dynid::ingest::Chunk&& chunk) { writer.write(chunk); });

@@ -41,6 +41,10 @@ struct LiveMergeStats {
 class LiveMerge {
  public:
   static constexpr std::size_t kMaxHeldFrames = 1u << 20;
+  /// Seconds of wall clock between two reads of the sources while frames arrive: a read per
+  /// frame (a system call per source) made a slow reader fall behind a busy bus (kernel drops
+  /// under ASan in the VM test); 5 ms is a fraction of a grid period.
+  static constexpr double kReadInterval = 0.005;
 
   /// `on_stop` hears at once of a source that stopped (its error), so a live user sees it.
   LiveMerge(CarPipeline& pipe, std::vector<FollowedSource> sources,
@@ -76,6 +80,7 @@ class LiveMerge {
   std::function<void(const std::string&)> on_stop_;
   std::deque<can::Frame> held_;
   double let_in_until_;  // newest time of a frame given to the pipeline
+  double last_read_;     // wall time of the last read of the sources
   LiveMergeStats stats_;
 
   void read_sources();
