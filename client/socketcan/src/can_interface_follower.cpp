@@ -8,17 +8,24 @@
 #include "dynid/error.hpp"
 
 namespace dynid::car {
+namespace {
+
+// Checked before any member uses it: the mapper reads the source's own bus profile.
+const AuxiliarySourceSpec& can_source(const AuxiliarySourceSpec& spec) {
+  if (spec.type != "can" || !spec.bus)
+    throw InputError("source '" + spec.name + "': only a CAN source is read from an interface");
+  return spec;
+}
+
+}  // namespace
 
 CanInterfaceFollower::CanInterfaceFollower(const AuxiliarySourceSpec& spec, const std::string& interface_name,
                                            double offset)
-    : spec_(spec),
+    : spec_(can_source(spec)),
       offset_(offset),
       socket_(interface_name),
       mapper_(*spec_.bus),
-      last_time_(spec_.channels.size(), -std::numeric_limits<double>::infinity()) {
-  if (spec_.type != "can" || !spec_.bus)
-    throw InputError("source '" + spec_.name + "': only a CAN source is read from an interface");
-}
+      last_time_(spec_.channels.size(), -std::numeric_limits<double>::infinity()) {}
 
 std::vector<AuxiliaryRow> CanInterfaceFollower::poll() {
   std::vector<AuxiliaryRow> out;

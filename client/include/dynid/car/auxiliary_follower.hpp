@@ -51,8 +51,6 @@ class AuxiliaryFollower final : public LiveSource {
   const std::string& name() const override { return spec_.name; }
   std::string origin() const override { return file_.string(); }
   std::uint64_t rows() const override { return rows_; }
-  const AuxiliarySourceSpec& spec() const { return spec_; }
-  const std::filesystem::path& file() const { return file_; }
   const AuxiliaryCsvParser& parser() const { return parser_; }
 
  private:
