@@ -34,6 +34,11 @@ std::string signature_text(const residual::Signature& s) {
   return out;
 }
 
+// A step's right answer also locates it: its 95 % set holds the time the simulated car changed.
+bool holds_change(const ModelRun& m, double change_time_s) {
+  return m.first_located_from_s <= change_time_s && change_time_s <= m.first_located_to_s;
+}
+
 // The loop on one model, with its guarantees checked.
 ModelRun trace_model(const RunSetup& setup, const std::string& name, const ingest::RecordedRun& run,
                      const std::vector<ingest::PreprocessedSegment>& segments, const std::map<std::string, double>& truth) {
@@ -51,6 +56,8 @@ ModelRun trace_model(const RunSetup& setup, const std::string& name, const inges
     m.first_effect = first.accepted->effect;
     m.first_partial = first.partial.has_value();
     m.first_finding = first.accepted->finding;
+    m.first_located_from_s = first.accepted->located_from_s;
+    m.first_located_to_s = first.accepted->located_to_s;
   }
   for (const residual::GroupFloor& g : first.floor.groups)
     if (g.ratio / g.upper_ratio > m.first_ratio / std::max(m.first_upper, 1e-300) || m.first_upper == 0.0) {
@@ -175,7 +182,7 @@ RunResult run_family(const RunSetup& setup, const Family& family, std::uint64_t 
       r.outcome = Outcome::kStructureRight;
     } else if (m.first_verdict == "structure left" && m.first_effect.empty()) {
       r.outcome = Outcome::kStructureMissed;
-    } else if (family.right(m.first_effect, draw)) {
+    } else if (family.right(m.first_effect, draw) && (family.kind != "step" || holds_change(m, truth.change_time_s))) {
       r.outcome = Outcome::kRight;
     } else if (family.proxy(m.first_effect, draw)) {
       r.outcome = Outcome::kProxy;

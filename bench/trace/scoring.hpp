@@ -4,6 +4,7 @@
 // the family's models with the profile's declared effects, and classify the loop's first answer;
 // check the loop's guarantees (no parameter ends outside its model's bounds; the held-out
 // residual at the end not above where it started, on the declared fit's group weights).
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -28,6 +29,8 @@ struct ModelRun {
   std::string first_effect;   ///< its accepted candidate ("" when none)
   bool first_partial = false; ///< that candidate explains a part only (verdict "structure left")
   std::string first_finding;  ///< e.g. "vx is 120 +- 3 ms late"
+  double first_located_from_s = std::nan("");  ///< a located step's 95 % set (effect_screen.hpp)
+  double first_located_to_s = std::nan("");
   double first_ratio = 0.0;   ///< residual / floor (ratio of squares), worst group
   double first_upper = 0.0;   ///< the floor test's critical ratio there
   double second_ratio = 0.0;  ///< the same after the first added effect (0 when none was added)

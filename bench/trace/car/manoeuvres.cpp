@@ -370,6 +370,7 @@ Truth longitudinal(const CarParameters& car, const Perturbation& p, std::uint64_
   std::vector<Sample> samples;
   double brake_start = -1.0;
   bool mass_added = false;
+  double mass_added_at = std::numeric_limits<double>::quiet_NaN();
   bool relaunched = false;
   for (int k = 0; k * kDt < duration; ++k) {
     const double t = k * kDt;
@@ -392,6 +393,7 @@ Truth longitudinal(const CarParameters& car, const Perturbation& p, std::uint64_
       if (!mass_added && t >= d.stop_time() + 1.2) {
         d.add_mass(p.mass_step);
         mass_added = true;
+        mass_added_at = t;
       }
       launch = t >= d.stop_time() + 2.5;
       relaunched = relaunched || launch;
@@ -407,6 +409,7 @@ Truth longitudinal(const CarParameters& car, const Perturbation& p, std::uint64_
                       {"SCx", car.scx},
                       {"rolling_resistance", car.rolling_resistance},
                       {"engine_inertia", car.engine_inertia}};
+  if (p.mass_step != 0.0) truth.change_time_s = mass_added_at;
   return truth;
 }
 
@@ -561,6 +564,7 @@ Truth lateral(const CarParameters& car, const Perturbation& p, std::uint64_t see
   truth.parameters = {{"yaw_inertia", car.yaw_inertia},
                       {"front_cornering_stiffness", car.front_cornering},
                       {"rear_cornering_stiffness", car.rear_cornering}};
+  if (p.rear_stiffness_step != 0.0) truth.change_time_s = p.step_time;
   return truth;
 }
 

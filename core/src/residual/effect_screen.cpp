@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include <boost/math/distributions/normal.hpp>
@@ -13,6 +14,7 @@
 #include "dynid/residual/road_profile.hpp"
 #include "dynid/residual/signal_delay.hpp"
 #include "dynid/residual/varying_parameter.hpp"
+#include "change_point.hpp"
 #include "folded_rows.hpp"
 #include "hac_wald.hpp"
 
@@ -282,6 +284,59 @@ Eigen::Index locate_delay(const DelayContext& in, const std::string& channel, Ei
   return best;
 }
 
+std::string seconds_text(double t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", std::round(t * 1e6) / 1e6);
+  return buf;
+}
+
+// "mass changes by +250 +- 12 kg at 31.6 s (95 % between 23.00 and 31.60 s); near it: the car
+// stood still 28.6-31.2 s": the change point's confidence set (a gap in the rows lies inside
+// it whole), then what happened within 2 s of it.
+std::string step_finding(const std::string& parameter, const CandidateScore& c, const detail::LocatedStep& step,
+                         const DelayContext& in) {
+  char text[256];
+  std::snprintf(text, sizeof text, "%s changes by %+.4g +- %.2g %s at %s s", parameter.c_str(), c.coefficient,
+                c.coefficient_std, c.coefficient_unit.c_str(), seconds_text(step.time_s).c_str());
+  std::string out = text;
+  std::snprintf(text, sizeof text, " (95 %% between %.2f and %.2f s)", step.earliest_s, step.latest_s);
+  out += text;
+  const std::string events = detail::events_near(in.run, in.rate, step.earliest_s, step.latest_s, 2.0);
+  if (!events.empty()) out += "; near it: " + events;
+  return out;
+}
+
+// The best significant step of each parameter (ranked) moved from its block boundary to the
+// change point the rows locate (change_point.hpp), judged again there like any candidate: its
+// significance stays the block step's (the test that found it), its figures are the located
+// step's. The finding names the time, the size and what happened near it.
+void locate_significant_steps(ScreenResult& result, const DelayContext& in) {
+  std::vector<std::string> located;
+  std::optional<detail::FoldedRows> declared;
+  for (CandidateScore& c : result.candidates) {
+    if (!c.significant || !c.evaluated || c.effect.rfind("step:", 0) != 0) continue;
+    const VaryingParameter v = parse_varying_effect(c.effect, in.model);
+    if (contains(located, v.parameter)) continue;
+    located.push_back(v.parameter);
+    if (!declared) declared = detail::fold_rows(in.model, in.declared, in.run, in.rate, in.odmf, in.fit, true, &in.rows);
+    const std::optional<detail::LocatedStep> step = detail::locate_step(*declared, v.column, in.weights);
+    if (!step) continue;
+    const std::string name = "step:" + v.parameter + "@" + seconds_text(step->time_s) + "s";
+    std::vector<std::string> with = in.declared;
+    with.push_back(name);
+    const Candidate candidate{name, varying_parameter_info(parse_varying_effect(name, in.model), in.model).description,
+                              CandidateKind::kVarying};
+    CandidateScore again = score(candidate, detail::fold_rows(in.model, with, in.run, in.rate, in.odmf, in.fit, true, &in.rows),
+                                 in.weights, in.odmf);
+    again.significant = c.significant;
+    again.detectable = c.detectable;
+    again.finding = step_finding(v.parameter, again, *step, in);
+    again.located_from_s = step->earliest_s;
+    again.located_to_s = step->latest_s;
+    c = std::move(again);
+  }
+}
+
 // Significance once every candidate is scored: the level is shared out among them.
 void decide(ScreenResult& result, double family_error_rate) {
   result.tests = static_cast<int>(std::count_if(result.candidates.begin(), result.candidates.end(),
@@ -455,6 +510,10 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
     c.finding = text;
   }
   std::stable_sort(result.candidates.begin(), result.candidates.end(), ranks_before);
+  if (options.varying_parameters) {
+    locate_significant_steps(result, delays);
+    std::stable_sort(result.candidates.begin(), result.candidates.end(), ranks_before);
+  }
   prefer_simplest_within_one_error(result.candidates);
   return result;
 }

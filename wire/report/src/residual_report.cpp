@@ -169,6 +169,8 @@ json candidate_json(const residual::CandidateScore& c) {
           {"testable", c.testable},
           {"significant", c.significant},
           {"finding", c.finding},
+          {"located_from_s", finite(c.located_from_s)},
+          {"located_to_s", finite(c.located_to_s)},
           {"coefficient", finite(c.coefficient)},
           {"coefficient_std", finite(c.coefficient_std)},
           {"coefficient_unit", c.coefficient_unit},

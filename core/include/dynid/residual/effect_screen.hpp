@@ -61,6 +61,7 @@
 // The report lists every tested candidate; the diagnosis takes the first that does not go below
 // the noise floor (diagnosis.hpp).
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -100,6 +101,9 @@ struct CandidateScore {
   /// What a located candidate found, in an engineer's words (a delay: "steer is 80 +- 4 ms
   /// late"); empty for the others.
   std::string finding;
+  /// A located step's 95 % confidence set for its time, s of run time (hull; NaN otherwise).
+  double located_from_s = std::numeric_limits<double>::quiet_NaN();
+  double located_to_s = std::numeric_limits<double>::quiet_NaN();
   bool significant = false;
   /// Single-column candidates: how much each declared parameter (in the declared fit's order)
   /// moves per unit of the candidate's coefficient when the candidate is left out: the
