@@ -176,8 +176,10 @@ std::vector<Family> make_families() {
                  return d;
                },
                [](const std::string& e, const Draw&) { return e == "drift:front_cornering_stiffness"; },
-               [](const std::string& e, const Draw&) { return starts(e, "step:front_cornering_stiffness@"); },
-               "step:front_cornering_stiffness (a trend seen as a step)"});
+               [](const std::string& e, const Draw&) {
+                 return starts(e, "step:front_cornering_stiffness@") || e == "drift:front_cornering_stiffness~distance";
+               },
+               "step:front_cornering_stiffness (a trend seen as a step), or a drift with distance (the same trend at a steady speed)"});
   f.push_back({"load_sensitivity", "interaction", Manoeuvre::kLateral, {"lateral_bicycle"}, Expect::kCandidate,
                "an interaction candidate (stiffness x ay^2); proxy tyre_saturation (|d| d ~ d |ay|)",
                [](std::mt19937_64& rng) {
@@ -215,9 +217,9 @@ std::vector<Family> make_families() {
                "delay:steer (a first-order lag looks like a delay below its corner)"});
   // --- clutch_slip, on the launch run ---
   f.push_back({"clutch_fade", "drift", Manoeuvre::kLaunch, {"clutch_slip"}, Expect::kCandidate,
-               "drift:coulomb_friction (labelled proxy: mu_c falls with dissipated energy, not time)",
+               "drift:coulomb_friction~clutch_energy (mu_c falls with the energy the clutch dissipates); proxy a drift with time",
                draw_value(&Perturbation::clutch_fade, 0.2, 0.4, "mu_c -%.0f %% per 100 kJ", 100.0),
-               never(),
+               [](const std::string& e, const Draw&) { return e == "drift:coulomb_friction~clutch_energy"; },
                [](const std::string& e, const Draw&) {
                  return e == "drift:coulomb_friction" || starts(e, "step:coulomb_friction@");
                },

@@ -207,6 +207,44 @@ TEST(Diagnosis, ADriftingOffsetIsExplainedByItsDrift) {
   EXPECT_NEAR(c.parameters.back().after, 0.4 / 60.0, 4.0 * c.parameters.back().std_after);
 }
 
+// A sensor scale that changes with the distance travelled (a parameter drifting with a
+// cumulative quantity), on a run that accelerates, so that distance (~ t^2) is not time: the
+// drift with distance explains it, not the drift with time, its rate recovered per metre.
+TEST(Diagnosis, AScaleThatDriftsWithDistanceIsExplainedByTheDistanceDrift) {
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> n01;
+  const Eigen::Index n = 6000;
+  Eigen::VectorXd vx(n), ax(n), distance(n);
+  double s = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / kRate;
+    const double v = 5.0 + 0.3 * t + 1.5 * std::sin(0.9 * t + 0.3);
+    distance(k) = s;
+    s += v / kRate;
+    vx(k) = v + 0.02 * n01(rng);
+  }
+  const double mean_distance = distance.mean();
+  constexpr double kPerMetre = 2e-4;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / kRate;
+    const double dv = 0.3 + 1.35 * std::cos(0.9 * t + 0.3);
+    ax(k) = (1.02 + kPerMetre * (distance(k) - mean_distance)) * dv + 0.15 + 0.05 * n01(rng);
+  }
+  const auto run = recorded({{"vx", vx}, {"ax", ax}});
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  const Diagnosis d = diagnose(*model, {}, run);
+  ASSERT_EQ(d.verdict, Verdict::kExplained) << d.statement();
+  EXPECT_EQ(d.accepted->effect, "drift:sensor_scale~distance") << d.statement();
+  const EffectComparison c = compare_effect(*model, {}, "drift:sensor_scale~distance", ingest::preprocess_offline(run),
+                                            kRate, run.announcement.preprocessing.odmf);
+  ASSERT_EQ(c.parameters.back().name, "sensor_scale_per_distance");
+  EXPECT_EQ(c.parameters.back().unit, "- per m");
+  EXPECT_NEAR(c.parameters.back().after, kPerMetre, 4.0 * c.parameters.back().std_after);
+  EXPECT_THROW(parse_varying_effect("drift:sensor_scale~nothing", *model), InputError);
+  EXPECT_THROW(parse_varying_effect("drift:nothing~distance", *model), InputError);
+  EXPECT_EQ(cumulative_quantities({"vx", "ax"}), std::vector<std::string>{"distance"});
+}
+
 // A sensor scale that grows with the speed (a parameter that depends on a channel): explained
 // by depends:sensor_scale~vx, its slope recovered in the parameter's unit per unit of vx.
 TEST(Diagnosis, AParameterThatDependsOnAChannelIsExplainedByTheDependence) {

@@ -77,6 +77,14 @@ std::vector<std::string> dependence_channels(const model::Model& m, const std::v
   return out;
 }
 
+// The model's physics channels that the run has (a cumulative quantity reads those only).
+std::vector<std::string> run_physics_channels(const model::Model& m, const std::vector<ingest::PreprocessedSegment>& run) {
+  std::vector<std::string> out;
+  for (const std::string& c : physics_channels(m))
+    if (run.front().channels.has(c)) out.push_back(c);
+  return out;
+}
+
 std::vector<Candidate> candidates_of(const model::Model& m, const std::vector<std::string>& declared,
                                      const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
                                      const ScreenOptions& options) {
@@ -90,7 +98,8 @@ std::vector<Candidate> candidates_of(const model::Model& m, const std::vector<st
     const bool dependences = options.dependences || !options.only.empty();
     for (const std::string& name :
          varying_candidates(m, t_first, t_last, options.fit.cross_validation.block_seconds,
-                            dependences ? dependence_channels(m, run) : std::vector<std::string>{}))
+                            dependences ? dependence_channels(m, run) : std::vector<std::string>{},
+                            cumulative_quantities(run_physics_channels(m, run))))
       all.push_back({name, varying_parameter_info(parse_varying_effect(name, m), m).description,
                      CandidateKind::kVarying});
   }

@@ -106,24 +106,34 @@ RowSelection kept_rows(const model::Model& model, const std::vector<std::string>
 
 namespace {
 
-// The run mean (over valid samples) of each dependence's channel (varying_parameter.hpp); 0
-// for the other varying parameters. InputError when the run lacks the channel.
-std::vector<double> channel_means(const std::vector<VaryingParameter>& varying,
-                                  const std::vector<ingest::PreprocessedSegment>& run) {
-  std::vector<double> out(varying.size(), 0.0);
+// What each varying parameter's column multiplies, per segment, centred on its run mean over
+// valid samples (varying_parameter.hpp): a dependence's channel, or a cumulative quantity
+// integrated from the run's start (a gap between segments adds nothing). Empty for a drift with
+// time or a step. InputError when the run lacks a channel.
+std::vector<std::vector<Eigen::VectorXd>> centred_series(const std::vector<VaryingParameter>& varying,
+                                                         const std::vector<ingest::PreprocessedSegment>& run) {
+  std::vector<std::vector<Eigen::VectorXd>> out(varying.size());
   for (std::size_t v = 0; v < varying.size(); ++v) {
-    if (varying[v].kind != VaryingParameter::Kind::kChannel) continue;
-    double sum = 0.0;
-    double count = 0.0;
+    const VaryingParameter& p = varying[v];
+    if (p.kind != VaryingParameter::Kind::kChannel && p.kind != VaryingParameter::Kind::kCumulative) continue;
+    double sum = 0.0, count = 0.0, accumulated = 0.0;
     for (const ingest::PreprocessedSegment& seg : run) {
-      if (!seg.channels.has(varying[v].channel))
-        throw InputError("effect 'depends:" + varying[v].parameter + "~" + varying[v].channel + "': the run has no channel '" +
-                         varying[v].channel + "'");
-      const Eigen::VectorXd& x = seg.channels[varying[v].channel];
+      Eigen::VectorXd x;
+      if (p.kind == VaryingParameter::Kind::kChannel) {
+        if (!seg.channels.has(p.channel))
+          throw InputError("effect 'depends:" + p.parameter + "~" + p.channel + "': the run has no channel '" + p.channel + "'");
+        x = seg.channels[p.channel];
+      } else {
+        const Eigen::VectorXd rate = cumulative_rate(p.channel, seg.channels);
+        x.resize(rate.size());
+        for (Eigen::Index k = 0; k < rate.size(); ++k) x(k) = accumulated += rate(k) * seg.channels.sample_period();
+      }
       for (Eigen::Index k = 0; k < x.size(); ++k)
         if (seg.channels.valid(k) && std::isfinite(x(k))) sum += x(k), count += 1.0;
+      out[v].push_back(std::move(x));
     }
-    out[v] = count > 0.0 ? sum / count : 0.0;
+    const double mean = count > 0.0 ? sum / count : 0.0;
+    for (Eigen::VectorXd& x : out[v]) x.array() -= mean;
   }
   return out;
 }
@@ -200,7 +210,7 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   const std::vector<ingest::PreprocessedSegment> delayed_run = delays.empty() ? std::vector<ingest::PreprocessedSegment>{}
                                                                              : delayed(run, delays);
   const std::vector<ingest::PreprocessedSegment>& rows_run = delays.empty() ? run : delayed_run;
-  const std::vector<double> centres = channel_means(varying, rows_run);
+  const std::vector<std::vector<Eigen::VectorXd>> centred = centred_series(varying, rows_run);
   for (std::size_t s = 0; s < rows_run.size(); ++s) {
     const ingest::PreprocessedSegment& seg = rows_run[s];
     const std::vector<Eigen::Index> kept = decimation_grid(seg, odmf);
@@ -220,11 +230,9 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
         const Eigen::Index grid_at = seg.first + sample;
         const double time_at = static_cast<double>(grid_at) / sample_rate_hz;
         for (std::size_t v = 0; v < varying.size(); ++v) {
-          const double centred = varying[v].kind == VaryingParameter::Kind::kChannel
-                                     ? seg.channels[varying[v].channel](sample) - centres[v]
-                                     : 0.0;
+          const double x = centred[v].empty() ? 0.0 : centred[v][s](sample);
           row[static_cast<std::size_t>(model_width) + v] =
-              varying_column(varying[v], gr.W(static_cast<Eigen::Index>(i), varying[v].column), time_at, t_mid, centred);
+              varying_column(varying[v], gr.W(static_cast<Eigen::Index>(i), varying[v].column), time_at, t_mid, x);
         }
         if (profile)
           profile->hats(profile->distance(s, sample),
