@@ -193,7 +193,7 @@ std::vector<Family> make_families() {
                [](const std::string& e, const Draw&) { return e == "tyre_saturation"; },
                "tyre_saturation (|d| d: the force's fall with slip, which follows ay)"});
   f.push_back({"imu_roll_mount", "misalignment", Manoeuvre::kLateral, {"lateral_bicycle"}, Expect::kCandidate,
-               "a misalignment candidate; proxy slip_offset (an ay offset g sin(phi) as constant slip offsets)",
+               "offset:ay (the accelerometer reads g sin(phi): a roll of its mount); proxy slip_offset (the ay offset as constant slip offsets)",
                [](std::mt19937_64& rng) {
                  Draw d;
                  const double deg = uniform(rng, 0.6, 2.0) * (rng() % 2 ? 1.0 : -1.0);
@@ -201,7 +201,7 @@ std::vector<Family> make_families() {
                  d.text = fmt("accelerometer rolled %+.1f deg on its mount", deg);
                  return d;
                },
-               [](const std::string& e, const Draw&) { return has(e, "misalign") || has(e, "mount"); },
+               [](const std::string& e, const Draw&) { return starts(e, "offset:ay@"); },
                [](const std::string& e, const Draw&) { return e == "slip_offset" || e == "steer_offset"; },
                "slip_offset / steer_offset (constant forces that absorb an ay offset)"});
   f.push_back({"tyre_relaxation", "inexpressible", Manoeuvre::kLateral, {"lateral_bicycle"}, Expect::kStructureLeft,

@@ -11,6 +11,7 @@
 #include "dynid/model/registry.hpp"
 #include "dynid/residual/diagnosis.hpp"
 #include "dynid/residual/effect_comparison.hpp"
+#include "dynid/residual/sensor_offset.hpp"
 #include "dynid/residual/signal_delay.hpp"
 #include "dynid/residual/trace.hpp"
 #include "dynid/residual/varying_parameter.hpp"
@@ -23,7 +24,10 @@ constexpr double kRate = 100.0;
 constexpr double kG = 9.80665;
 
 // Units of the catalogue (docs/CHANNELS.md): models check them.
-std::string unit_of(const std::string& channel) { return channel == "ax" ? "m/s^2" : "m/s"; }
+std::string unit_of(const std::string& channel) {
+  if (channel == "ax" || channel == "ay") return "m/s^2";
+  return channel == "yaw_rate" ? "rad/s" : "m/s";
+}
 
 ingest::RecordedRun recorded(const std::vector<std::pair<std::string, Eigen::VectorXd>>& channels) {
   ingest::RecordedRun run;
@@ -243,6 +247,58 @@ TEST(Diagnosis, AScaleThatDriftsWithDistanceIsExplainedByTheDistanceDrift) {
   EXPECT_THROW(parse_varying_effect("drift:sensor_scale~nothing", *model), InputError);
   EXPECT_THROW(parse_varying_effect("drift:nothing~distance", *model), InputError);
   EXPECT_EQ(cumulative_quantities({"vx", "ax"}), std::vector<std::string>{"distance"});
+}
+
+// A yaw-rate sensor with a bias (sensor_offset.hpp): in ay = s (d_vy + vx r) + o it acts as
+// s vx b, not a constant, so the model's own offset cannot take it. Found as the sensor's
+// offset, its value recovered, the model adequate once the rows read the sensor without it.
+TEST(Diagnosis, ARateSensorBiasIsFoundAsTheSensorsOffset) {
+  std::mt19937_64 rng(23);
+  std::normal_distribution<double> n01;
+  const Eigen::Index n = 6000;
+  constexpr double kBias = 0.01;  // rad/s
+  Eigen::VectorXd vx(n), vy(n), r(n), ay(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / kRate;
+    const double speed = 15.0 + 4.0 * std::sin(0.21 * t);
+    const double yaw = 0.1 * std::sin(0.5 * t) + 0.05 * std::sin(1.3 * t + 0.4);
+    const double dvy = 0.3 * 0.5 * std::cos(0.5 * t + 0.5);
+    vx(k) = speed + 0.02 * n01(rng);
+    vy(k) = 0.3 * std::sin(0.5 * t + 0.5) + 0.002 * n01(rng);
+    r(k) = yaw + kBias + 0.001 * n01(rng);
+    ay(k) = dvy + speed * yaw + 0.05 * n01(rng);
+  }
+  const auto run = recorded({{"vx", vx}, {"vy", vy}, {"yaw_rate", r}, {"ay", ay}});
+  const auto model = model::make_model("kinematic_lateral", {});
+  const Diagnosis d = diagnose(*model, {}, run);
+  ASSERT_EQ(d.verdict, Verdict::kExplained) << d.statement();
+  const SensorOffset found = parse_offset_effect(d.accepted->effect);
+  EXPECT_EQ(found.channel, "yaw_rate") << d.statement();
+  EXPECT_NEAR(found.value, kBias, 4.0 * d.accepted->coefficient_std) << d.statement();
+  EXPECT_EQ(d.accepted->finding.rfind("yaw_rate reads +", 0), 0U) << d.accepted->finding;
+  EXPECT_NE(d.accepted->finding.find("rad/s too much"), std::string::npos) << d.accepted->finding;
+  const Diagnosis after = diagnose(*model, {d.accepted->effect}, run);
+  EXPECT_EQ(after.verdict, Verdict::kAdequate) << after.statement();
+}
+
+TEST(SensorOffset, NamesParseAndTheAngleAnAccelerometerOffsetMeans) {
+  EXPECT_EQ(offset_effect_name("ay", 0.171), "offset:ay@+0.171");
+  const SensorOffset o = parse_offset_effect("offset:ay@+0.171");
+  EXPECT_EQ(o.channel, "ay");
+  EXPECT_DOUBLE_EQ(o.value, 0.171);
+  EXPECT_DOUBLE_EQ(parse_offset_effect("offset:yaw_rate@-0.002").value, -0.002);
+  EXPECT_THROW(parse_offset_effect("offset:ay"), InputError);
+  EXPECT_THROW(parse_offset_effect("offset:@1"), InputError);
+  EXPECT_THROW(parse_offset_effect("offset:ay@nan"), InputError);
+  EXPECT_THROW(parse_offset_effect("delay:ay@10ms"), InputError);
+  // g sin(1 deg) = 0.17115 m/s^2 on ay: rolled by one degree.
+  const std::string text = offset_finding("ay", "m/s^2", 9.80665 * std::sin(std::numbers::pi / 180.0), 0.001);
+  EXPECT_NE(text.find("rolled +1.00"), std::string::npos) << text;
+  EXPECT_NE(offset_finding("ax", "m/s^2", -0.17115, 0.001).find("pitched -1.00"), std::string::npos);
+  EXPECT_EQ(offset_finding("yaw_rate", "rad/s", 0.01, 0.001).find("deg"), std::string::npos);
+  EXPECT_TRUE(is_mounted_sensor("yaw_rate", "rad/s"));
+  EXPECT_TRUE(is_mounted_sensor("ax", "m/s^2"));
+  EXPECT_FALSE(is_mounted_sensor("engine_speed", "rad/s"));
 }
 
 // A sensor scale that grows with the speed (a parameter that depends on a channel): explained

@@ -91,8 +91,10 @@ TEST(EffectScreen, FindsTheMissingGradeAndRecoversTheParametersExactly) {
   EXPECT_EQ(screen.best()->effect, "road_grade");
   EXPECT_EQ(screen.best()->kind, CandidateKind::kPhysics);
   EXPECT_GT(screen.best()->held_out_drop, 0.999);
-  for (const CandidateScore& c : screen.candidates)
+  for (const CandidateScore& c : screen.candidates) {
+    if (c.kind != CandidateKind::kDictionary) continue;  // an offset of ax is a sensor's, not a term of y
     EXPECT_EQ(c.effect.find(":ax"), std::string::npos) << "a dictionary term over the measured side: " << c.effect;
+  }
   const EffectComparison cmp = compare_effect(*model, {}, "road_grade", run, kRate, 1, {},
                                               {{"sensor_scale", 1.02}, {"sensor_offset", 0.15}});
   for (const ParameterChange& p : cmp.parameters) {

@@ -212,13 +212,13 @@ double lowest_ratio(const GroupFloor& g, std::size_t groups) {
 }
 
 // The sensors a candidate reads beyond the model's own columns: a physical effect's channels, a
-// dictionary term's or a delay's channel.
+// dictionary term's, a delay's or an offset's channel.
 std::vector<std::string> sensors_of(const CandidateScore& c, const std::vector<model::Effect>& effects) {
   for (const model::Effect& e : effects)
     if (e.name == c.effect) return e.channels;
   if (model::is_dictionary_effect(c.effect)) return model::dictionary_effect(c.effect, {"model"}).channels;
-  if (c.effect.rfind("delay:", 0) == 0) {  // delay:<channel>@<ms>
-    const std::string channel = c.effect.substr(c.effect.rfind(':') + 1);
+  if (c.effect.rfind("delay:", 0) == 0 || c.effect.rfind("offset:", 0) == 0) {  // <kind>:<channel>@<value>
+    const std::string channel = c.effect.substr(c.effect.find(':') + 1);
     return {channel.substr(0, channel.find('@'))};
   }
   return {};

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <optional>
 #include <utility>
 
@@ -12,6 +13,7 @@
 #include "dynid/error.hpp"
 #include "dynid/model/effects.hpp"
 #include "dynid/residual/road_profile.hpp"
+#include "dynid/residual/sensor_offset.hpp"
 #include "dynid/residual/signal_delay.hpp"
 #include "dynid/residual/varying_parameter.hpp"
 #include "change_point.hpp"
@@ -188,7 +190,13 @@ std::vector<std::string> delay_channels(const model::Model& m, const std::vector
   return out;
 }
 
-struct DelayContext {
+// A residual at a grid index (NaN when that row is not there: the row is left out).
+double at_grid(const std::vector<std::pair<Eigen::Index, double>>& r, Eigen::Index grid) {
+  const auto it = std::lower_bound(r.begin(), r.end(), std::make_pair(grid, -std::numeric_limits<double>::infinity()));
+  return it != r.end() && it->first == grid ? it->second : std::numeric_limits<double>::quiet_NaN();
+}
+
+struct SignalContext {
   const model::Model& model;
   const std::vector<std::string>& declared;
   const std::vector<ingest::PreprocessedSegment>& run;
@@ -210,7 +218,7 @@ std::vector<std::string> with_delay(const std::vector<std::string>& declared, co
 // of delay) at the solution x0, from the rows built one sample later and one earlier. At zero it
 // tests "no delay"; at the delay found, its coefficient's standard deviation is the delay's
 // (Gauss-Newton).
-CandidateScore score_delay(const DelayContext& in, const std::string& channel, const Eigen::VectorXd& x0,
+CandidateScore score_delay(const SignalContext& in, const std::string& channel, const Eigen::VectorXd& x0,
                            Eigen::Index center = 0) {
   const detail::FoldedRows base = detail::fold_rows(
       in.model, center == 0 ? in.declared : with_delay(in.declared, channel, center, in.rate), in.run, in.rate,
@@ -224,32 +232,29 @@ CandidateScore score_delay(const DelayContext& in, const std::string& channel, c
   const detail::GridResiduals late = residuals(center + 1);
   const detail::GridResiduals early = residuals(center - 1);
   std::vector<std::vector<double>> column(base.groups.size());
-  for (std::size_t g = 0; g < base.groups.size(); ++g) {
-    const auto find = [](const std::vector<std::pair<Eigen::Index, double>>& r, Eigen::Index grid) {
-      const auto it = std::lower_bound(r.begin(), r.end(), std::make_pair(grid, -std::numeric_limits<double>::infinity()));
-      return it != r.end() && it->first == grid ? it->second : std::numeric_limits<double>::quiet_NaN();
-    };
+  for (std::size_t g = 0; g < base.groups.size(); ++g)
     for (const Eigen::Index grid : base.collected.grid_index[g])
-      column[g].push_back(0.5 * (find(early[g], grid) - find(late[g], grid)));
-  }
+      column[g].push_back(0.5 * (at_grid(early[g], grid) - at_grid(late[g], grid)));
   const model::ParameterInfo info{channel + "_delay", "samples", "delay of " + channel + " (first order)", std::nullopt};
   const Candidate c{"delay:" + channel, "the " + channel + " signal late or early against the others",
                     CandidateKind::kTiming};
   return score(c, detail::with_extra_column(base, column, info, in.fit.cross_validation), in.weights, in.odmf);
 }
 
-// The located delay judged like any other candidate, on the rows built at the delay found: the
+// A located delay or offset judged like any other candidate, on the rows built with it: the
 // declared model on those rows against the declared model on its own, both under the declared
 // weights, per row (the shift drops the few rows whose source leaves their segment). Why: the
 // score column is a linearisation at zero delay; it ranked a steering signal 117 ms late at
 // -47 % held out where the rows at the delay give -87 % (bench/trace).
-void rescore_at_delay(CandidateScore& c, const DelayContext& in, Eigen::Index found) {
+void rescore_with(CandidateScore& c, const SignalContext& in, const std::string& effect) {
   const auto evaluated = [&](const std::vector<std::string>& effects) {
     return detail::evaluate(detail::fold_rows(in.model, effects, in.run, in.rate, in.odmf, in.fit, false, &in.rows), {},
                             in.weights);
   };
   const detail::Evaluation before = evaluated(in.declared);
-  const detail::Evaluation after = evaluated(with_delay(in.declared, c.effect.substr(6), found, in.rate));
+  std::vector<std::string> with = in.declared;
+  with.push_back(effect);
+  const detail::Evaluation after = evaluated(with);
   const auto nb = static_cast<double>(std::max<std::uint64_t>(before.total_rows(), 1));
   const auto na = static_cast<double>(std::max<std::uint64_t>(after.total_rows(), 1));
   const double in_before = before.weighted_in() / nb;
@@ -270,9 +275,78 @@ void rescore_at_delay(CandidateScore& c, const DelayContext& in, Eigen::Index fo
   }
 }
 
+// The channels whose offset the screen tests (sensor_offset.hpp): the model's accelerometers
+// and rate sensors that the run has, not declared offset already. The measured side is not left
+// out, as it is from the dictionary: an offset's column is y's derivative in the channel (the
+// mass, for m ay), not y's own values, and it cannot mimic any residual.
+std::vector<std::pair<std::string, std::string>> offset_channels(const model::Model& m,
+                                                                 const std::vector<ingest::PreprocessedSegment>& run,
+                                                                 const std::vector<std::string>& declared) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const model::ChannelNeed& c : m.channels()) {
+    if (!is_mounted_sensor(c.name, c.unit) || !run.front().channels.has(c.name)) continue;
+    const bool already = std::any_of(declared.begin(), declared.end(), [&](const std::string& e) {
+      return is_offset_effect(e) && parse_offset_effect(e).channel == c.name;
+    });
+    if (!already) out.emplace_back(c.name, c.unit);
+  }
+  return out;
+}
+
+std::vector<std::string> with_offset(const std::vector<std::string>& declared, const std::string& channel, double value) {
+  std::vector<std::string> out = declared;
+  if (value != 0.0) out.push_back(offset_effect_name(channel, value));
+  return out;
+}
+
+// The score test of an offset of `channel` around `center` (its unit): the column -d r / d offset
+// at the solution x0, by central difference (a model linear in the channel makes it exact); the
+// coefficient is the offset beyond `center`.
+CandidateScore score_offset(const SignalContext& in, const std::string& channel, const std::string& unit,
+                            const Eigen::VectorXd& x0, double center = 0.0) {
+  constexpr double kStep = 0.01;  // in the channel's unit: any step is exact for a linear channel
+  const detail::FoldedRows base = detail::fold_rows(in.model, with_offset(in.declared, channel, center), in.run,
+                                                    in.rate, in.odmf, in.fit, true, &in.rows);
+  const auto residuals = [&](double value) {
+    return detail::residuals_at(detail::fold_rows(in.model, with_offset(in.declared, channel, value), in.run, in.rate,
+                                                  in.odmf, in.fit, true, &in.rows),
+                                x0);
+  };
+  const detail::GridResiduals up = residuals(center + kStep);
+  const detail::GridResiduals down = residuals(center - kStep);
+  std::vector<std::vector<double>> column(base.groups.size());
+  for (std::size_t g = 0; g < base.groups.size(); ++g)
+    for (const Eigen::Index grid : base.collected.grid_index[g])
+      column[g].push_back((at_grid(down[g], grid) - at_grid(up[g], grid)) / (2.0 * kStep));
+  const model::ParameterInfo info{channel + "_offset", unit, "what " + channel + " reads too much", std::nullopt};
+  const Candidate c{"offset:" + channel, "the " + channel + " sensor reads an offset (a tilted mount, a bias)",
+                    CandidateKind::kSensor};
+  return score(c, detail::with_extra_column(base, column, info, in.fit.cross_validation), in.weights, in.odmf);
+}
+
+// A significant offset found by two Gauss-Newton steps from zero, judged again on the rows built
+// with it, and named with its value (offset:ay@+0.171), its std and the mounting angle it means.
+void locate_offset(CandidateScore& c, const SignalContext& in, const std::string& unit) {
+  const std::string channel = c.effect.substr(std::string("offset:").size());
+  double value = c.coefficient;
+  CandidateScore at_value;
+  for (int step = 0; step < 2; ++step) {
+    const detail::FoldedRows rows = detail::fold_rows(in.model, with_offset(in.declared, channel, value), in.run,
+                                                      in.rate, in.odmf, in.fit, false, &in.rows);
+    const Eigen::VectorXd x = detail::base_solution(detail::evaluate(rows, {}, in.weights).all);
+    at_value = score_offset(in, channel, unit, x, value);
+    value += at_value.coefficient;
+  }
+  rescore_with(c, in, offset_effect_name(channel, value));
+  c.effect = offset_effect_name(channel, value);
+  c.coefficient = value;
+  c.coefficient_std = at_value.coefficient_std;
+  c.finding = offset_finding(channel, unit, value, at_value.coefficient_std);
+}
+
 // The delay with the least in-sample weighted residual per row, within +-max samples: steps of
 // 2 samples, then the neighbours of the best.
-Eigen::Index locate_delay(const DelayContext& in, const std::string& channel, Eigen::Index max) {
+Eigen::Index locate_delay(const SignalContext& in, const std::string& channel, Eigen::Index max) {
   const auto cost = [&](Eigen::Index samples) {
     const detail::FoldedRows rows = detail::fold_rows(
         in.model, samples == 0 ? in.declared : with_delay(in.declared, channel, samples, in.rate), in.run, in.rate,
@@ -303,7 +377,7 @@ std::string seconds_text(double t) {
 // stood still 28.6-31.2 s": the change point's confidence set (a gap in the rows lies inside
 // it whole), then what happened within 2 s of it.
 std::string step_finding(const std::string& parameter, const CandidateScore& c, const detail::LocatedStep& step,
-                         const DelayContext& in) {
+                         const SignalContext& in) {
   char text[256];
   std::snprintf(text, sizeof text, "%s changes by %+.4g +- %.2g %s at %s s", parameter.c_str(), c.coefficient,
                 c.coefficient_std, c.coefficient_unit.c_str(), seconds_text(step.time_s).c_str());
@@ -319,7 +393,7 @@ std::string step_finding(const std::string& parameter, const CandidateScore& c, 
 // change point the rows locate (change_point.hpp), judged again there like any candidate: its
 // significance stays the block step's (the test that found it), its figures are the located
 // step's. The finding names the time, the size and what happened near it.
-void locate_significant_steps(ScreenResult& result, const DelayContext& in) {
+void locate_significant_steps(ScreenResult& result, const SignalContext& in) {
   std::vector<std::string> located;
   std::optional<detail::FoldedRows> declared;
   for (CandidateScore& c : result.candidates) {
@@ -343,6 +417,21 @@ void locate_significant_steps(ScreenResult& result, const DelayContext& in) {
     again.located_from_s = step->earliest_s;
     again.located_to_s = step->latest_s;
     c = std::move(again);
+  }
+}
+
+// The score `score_it` gives, or, when the candidate cannot be built on this run (a missing
+// channel, no row), the candidate untested with the reason.
+template <typename ScoreIt>
+CandidateScore scored_or_why(const std::string& effect, CandidateKind kind, ScoreIt score_it) {
+  try {
+    return score_it();
+  } catch (const InputError& e) {
+    CandidateScore s;
+    s.effect = effect;
+    s.kind = kind;
+    s.note = e.what();
+    return s;
   }
 }
 
@@ -410,9 +499,9 @@ std::string percent(double fraction) {
 // The one-standard-error rule (see the header): the best significant candidate of the first
 // kind that is within one standard error of the best overall moves to the front.
 void prefer_simplest_within_one_error(std::vector<CandidateScore>& ranked) {
-  if (ranked.empty() || !ranked.front().significant || ranked.front().kind == CandidateKind::kPhysics) return;
+  if (ranked.empty() || !ranked.front().significant || ranked.front().kind == CandidateKind::kSensor) return;
   const CandidateScore& best = ranked.front();
-  for (int kind = static_cast<int>(CandidateKind::kPhysics); kind < static_cast<int>(best.kind); ++kind) {
+  for (int kind = static_cast<int>(CandidateKind::kSensor); kind < static_cast<int>(best.kind); ++kind) {
     const auto first = std::find_if(ranked.begin(), ranked.end(), [&](const CandidateScore& c) {
       return c.significant && static_cast<int>(c.kind) == kind;
     });
@@ -425,12 +514,12 @@ void prefer_simplest_within_one_error(std::vector<CandidateScore>& ranked) {
   }
 }
 
-
 const char* kind_name(CandidateKind kind) {
   switch (kind) {
     case CandidateKind::kPhysics: return "physics";
     case CandidateKind::kVarying: return "varying";
     case CandidateKind::kTiming: return "timing";
+    case CandidateKind::kSensor: return "sensor";
     case CandidateKind::kRoadProfile: return "road profile";
     case CandidateKind::kDictionary: return "dictionary";
   }
@@ -482,22 +571,27 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
       result.candidates.push_back(std::move(s));
     }
   }
-  const DelayContext delays{model, declared, run, sample_rate_hz, odmf, fold_options, declared_rows, weights};
+  const SignalContext delays{model, declared, run, sample_rate_hz, odmf, fold_options, declared_rows, weights};
   if (options.delays && options.only.empty()) {
     const Eigen::VectorXd x0 = detail::base_solution(result.fit.estimate);
     for (const std::string& channel : delay_channels(model, run, declared)) {
-      try {
-        result.candidates.push_back(score_delay(delays, channel, x0));
-      } catch (const InputError& e) {
-        CandidateScore s;
-        s.effect = "delay:" + channel;
-        s.kind = CandidateKind::kTiming;
-        s.note = e.what();
-        result.candidates.push_back(std::move(s));
-      }
+      result.candidates.push_back(scored_or_why("delay:" + channel, CandidateKind::kTiming,
+                                                [&] { return score_delay(delays, channel, x0); }));
+    }
+  }
+  std::map<std::string, std::string> offset_units;
+  if (options.sensor_offsets && options.only.empty()) {
+    const Eigen::VectorXd x0 = detail::base_solution(result.fit.estimate);
+    for (const auto& [channel, unit] : offset_channels(model, run, declared)) {
+      offset_units[channel] = unit;
+      result.candidates.push_back(scored_or_why("offset:" + channel, CandidateKind::kSensor,
+                                                [&] { return score_offset(delays, channel, unit, x0); }));
     }
   }
   decide(result, options.family_error_rate);
+  for (CandidateScore& c : result.candidates)
+    if (c.significant && c.kind == CandidateKind::kSensor && c.effect.find('@') == std::string::npos)
+      locate_offset(c, delays, offset_units.at(c.effect.substr(std::string("offset:").size())));
   // A significant delay is located and offered under its name (delay:steer@80ms), with the
   // score column's standard deviation as the delay's.
   for (CandidateScore& c : result.candidates) {
@@ -511,7 +605,7 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
                                                           run, sample_rate_hz, odmf, fold_options, false, &declared_rows);
     const Eigen::VectorXd x_found = detail::base_solution(detail::evaluate(at_found, {}, weights).all);
     const double std_ms = ms_per_sample * score_delay(delays, channel, x_found, found).coefficient_std;
-    rescore_at_delay(c, delays, found);
+    rescore_with(c, delays, delay_effect_name(channel, found, sample_rate_hz));
     c.effect = delay_effect_name(channel, found, sample_rate_hz);
     char text[160];
     std::snprintf(text, sizeof text, "%s is %.0f +- %.0f ms %s", channel.c_str(), std::abs(static_cast<double>(found) * ms_per_sample),

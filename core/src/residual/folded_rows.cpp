@@ -10,6 +10,7 @@
 #include "dynid/error.hpp"
 #include "dynid/model/parameter_status.hpp"
 #include "dynid/residual/road_profile.hpp"
+#include "dynid/residual/sensor_offset.hpp"
 #include "dynid/residual/signal_delay.hpp"
 #include "dynid/residual/varying_parameter.hpp"
 
@@ -77,8 +78,25 @@ std::vector<Eigen::Index> decimation_grid(const ingest::PreprocessedSegment& seg
 std::vector<std::string> without_profiles(const std::vector<std::string>& effects) {
   std::vector<std::string> out;
   for (const std::string& e : effects)
-    if (!is_road_profile_effect(e) && !is_varying_effect(e) && !is_delay_effect(e)) out.push_back(e);
+    if (!is_road_profile_effect(e) && !is_varying_effect(e) && !is_delay_effect(e) && !is_offset_effect(e))
+      out.push_back(e);
   return out;
+}
+
+// The run as the effects that change signals say it was measured: delayed channels read on
+// time, offset channels read without their offset.
+std::vector<ingest::PreprocessedSegment> signals_corrected(const std::vector<ingest::PreprocessedSegment>& input,
+                                                           const std::vector<std::string>& effects,
+                                                           double sample_rate_hz) {
+  std::vector<SignalDelay> delays;
+  std::vector<SensorOffset> offsets;
+  for (const std::string& e : effects) {
+    if (is_delay_effect(e)) delays.push_back(parse_delay_effect(e, sample_rate_hz));
+    if (is_offset_effect(e)) offsets.push_back(parse_offset_effect(e));
+  }
+  if (delays.empty() && offsets.empty()) return input;
+  const std::vector<ingest::PreprocessedSegment> on_time = delays.empty() ? input : delayed(input, delays);
+  return offsets.empty() ? on_time : offset_corrected(on_time, offsets);
 }
 
 bool listed(const std::vector<Eigen::Index>& sorted, Eigen::Index sample) {
@@ -90,10 +108,7 @@ bool listed(const std::vector<Eigen::Index>& sorted, Eigen::Index sample) {
 RowSelection kept_rows(const model::Model& model, const std::vector<std::string>& effects,
                        const std::vector<ingest::PreprocessedSegment>& input, double sample_rate_hz, int odmf) {
   const std::vector<std::string> model_effects = without_profiles(effects);
-  std::vector<SignalDelay> delays;
-  for (const std::string& e : effects)
-    if (is_delay_effect(e)) delays.push_back(parse_delay_effect(e, sample_rate_hz));
-  const std::vector<ingest::PreprocessedSegment> run = delays.empty() ? input : delayed(input, delays);
+  const std::vector<ingest::PreprocessedSegment> run = signals_corrected(input, effects, sample_rate_hz);
   RowSelection out(run.size(), std::vector<std::vector<Eigen::Index>>(model.groups().size()));
   for (std::size_t s = 0; s < run.size(); ++s) {
     const std::vector<Eigen::Index> kept = decimation_grid(run[s], odmf);
@@ -147,13 +162,12 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   if (odmf < 1) throw InputError("residual analysis: odmf " + std::to_string(odmf) + " < 1");
   std::vector<std::string> model_effects;
   std::vector<VaryingParameter> varying;
-  std::vector<SignalDelay> delays;
   std::string profile_effect;
   for (const std::string& e : effects) {
     if (is_varying_effect(e)) {
       varying.push_back(parse_varying_effect(e, model));
-    } else if (is_delay_effect(e)) {
-      delays.push_back(parse_delay_effect(e, sample_rate_hz));
+    } else if (is_delay_effect(e) || is_offset_effect(e)) {
+      continue;  // signals_corrected
     } else if (!is_road_profile_effect(e)) {
       model_effects.push_back(e);
     } else if (profile_effect.empty()) {
@@ -186,7 +200,7 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   } else if (is_varying_effect(effects.back())) {
     out.last_effect_first = varying_end - 1;
     out.last_effect_end = varying_end;
-  } else if (is_delay_effect(effects.back())) {  // no column: the rows themselves change
+  } else if (is_delay_effect(effects.back()) || is_offset_effect(effects.back())) {  // no column: the rows change
     out.last_effect_first = out.last_effect_end = width;
   } else {
     const std::vector<std::string> before(model_effects.begin(), model_effects.end() - 1);
@@ -207,9 +221,12 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
   }
   SegmentBuffers buffers(options.cross_validation.folds, group_count);
   std::vector<double> row(static_cast<std::size_t>(width + 1));
-  const std::vector<ingest::PreprocessedSegment> delayed_run = delays.empty() ? std::vector<ingest::PreprocessedSegment>{}
-                                                                             : delayed(run, delays);
-  const std::vector<ingest::PreprocessedSegment>& rows_run = delays.empty() ? run : delayed_run;
+  // A copy of the run only when an effect changes its signals (the screen folds hundreds of times).
+  const bool corrected = std::any_of(effects.begin(), effects.end(),
+                                     [](const std::string& e) { return is_delay_effect(e) || is_offset_effect(e); });
+  const std::vector<ingest::PreprocessedSegment> corrected_run =
+      corrected ? signals_corrected(run, effects, sample_rate_hz) : std::vector<ingest::PreprocessedSegment>{};
+  const std::vector<ingest::PreprocessedSegment>& rows_run = corrected ? corrected_run : run;
   const std::vector<std::vector<Eigen::VectorXd>> centred = centred_series(varying, rows_run);
   for (std::size_t s = 0; s < rows_run.size(); ++s) {
     const ingest::PreprocessedSegment& seg = rows_run[s];

@@ -72,7 +72,7 @@
 namespace dynid::residual {
 
 /// In ranking order (see above).
-enum class CandidateKind { kPhysics, kRoadProfile, kTiming, kVarying, kDictionary };
+enum class CandidateKind { kSensor, kPhysics, kRoadProfile, kTiming, kVarying, kDictionary };
 const char* kind_name(CandidateKind kind);
 
 struct CandidateScore {
@@ -132,6 +132,7 @@ struct ScreenOptions {
   /// fitting kinematic lateral model ahead of the bank. Named in `only`, it is tested.
   bool dependences = false;
   bool delays = true;              ///< signal delays of the model's channels (signal_delay.hpp)
+  bool sensor_offsets = true;      ///< offsets of its accelerometers and rate sensors (sensor_offset.hpp)
   double max_delay_s = 0.5;        ///< searched both ways
   /// When not empty, only these candidates (any kind) are tested.
   std::vector<std::string> only;
