@@ -211,6 +211,25 @@ TEST(Diagnosis, ADriftingOffsetIsExplainedByItsDrift) {
   EXPECT_NEAR(c.parameters.back().after, 0.4 / 60.0, 4.0 * c.parameters.back().std_after);
 }
 
+// The located delay's 95 % profile-likelihood interval holds the true delay: at least 7 of 10
+// seeds (a calibrated interval fails that with probability 0.1 %). Measured: 9 of 10, the miss
+// 20 ms off (two samples); two of the Gauss-Newton std it replaces (1-2 ms) held 200 ms only
+// where the estimate was exact, 6 of 10.
+TEST(Diagnosis, TheDelaysIntervalCoversTheTrueDelay) {
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  int covered = 0;
+  for (std::uint64_t seed = 30; seed < 40; ++seed) {
+    const Diagnosis d = diagnose(*model, {}, kinematic_run(seed, 0.0, 0.200));
+    ASSERT_TRUE(d.accepted.has_value()) << d.statement();
+    ASSERT_EQ(d.accepted->effect.rfind("delay:vx@", 0), 0U) << d.statement();
+    const bool holds = d.accepted->located_from_s <= 0.200 && 0.200 <= d.accepted->located_to_s;
+    std::printf("seed %llu: %s%s\n", static_cast<unsigned long long>(seed), d.accepted->finding.c_str(),
+                holds ? "" : "  <- misses 200 ms");
+    covered += holds ? 1 : 0;
+  }
+  EXPECT_GE(covered, 7);
+}
+
 // A sensor scale that changes with the distance travelled (a parameter drifting with a
 // cumulative quantity), on a run that accelerates, so that distance (~ t^2) is not time: the
 // drift with distance explains it, not the drift with time, its rate recovered per metre.
@@ -361,9 +380,9 @@ TEST(Diagnosis, AStepOfAParameterIsLocatedAndSized) {
 }
 
 // The speed signal recorded 200 ms late: the delay is found on the raw grid, named in ms with its
-// standard deviation, and once added the model is adequate. (At 80 ms this slow run's residual
-// is 1.31 times the floor's mean square, at the edge of the floor test: adequate.) Located within
-// one sample here (190 ms); its Gauss-Newton std (1 ms) is optimistic, docs/RESIDUAL.md.
+// interval, and once added the model is adequate. (At 80 ms this slow run's residual is 1.31
+// times the floor's mean square, at the edge of the floor test: adequate.) Located within one
+// sample here (190 ms); TheDelaysIntervalCoversTheTrueDelay measures the interval's coverage.
 TEST(Diagnosis, ASignalRecordedLateIsFoundInMilliseconds) {
   const auto run = kinematic_run(13, 0.0, 0.200);
   const auto model = model::make_model("kinematic_longitudinal", {});
@@ -374,6 +393,7 @@ TEST(Diagnosis, ASignalRecordedLateIsFoundInMilliseconds) {
   EXPECT_NEAR(static_cast<double>(found.samples), 20.0, 1.0) << d.accepted->effect;
   EXPECT_EQ(d.accepted->finding.rfind("vx is ", 0), 0U) << d.accepted->finding;
   EXPECT_NE(d.accepted->finding.find(" ms late"), std::string::npos) << d.accepted->finding;
+  EXPECT_LT(d.accepted->located_from_s, d.accepted->located_to_s) << d.accepted->finding;
   const Trace t = trace(*model, {}, run);
   EXPECT_EQ(t.added(), std::vector<std::string>{d.accepted->effect}) << t.stopped;
   EXPECT_EQ(t.rounds.back().diagnosis.verdict, Verdict::kAdequate) << t.rounds.back().diagnosis.statement();

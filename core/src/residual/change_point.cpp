@@ -48,23 +48,6 @@ std::vector<Eigen::Index> latest_first(const std::vector<double>& time_s) {
   return order;
 }
 
-// The long-run variance per row of a residual in time order over its variance: 1 + 2 sum of
-// Bartlett-weighted autocorrelations up to Newey-West's bandwidth 4 (n / 100)^(2/9), at least 1.
-double long_run_factor(const Eigen::VectorXd& e, const std::vector<Eigen::Index>& order) {
-  const auto n = static_cast<Eigen::Index>(order.size());
-  Eigen::VectorXd x(n);
-  for (Eigen::Index k = 0; k < n; ++k) x(k) = e(order[static_cast<std::size_t>(k)]);
-  const double c0 = x.squaredNorm();
-  if (!(c0 > 0.0)) return 1.0;
-  const auto bandwidth =
-      static_cast<Eigen::Index>(std::ceil(4.0 * std::pow(static_cast<double>(n) / 100.0, 2.0 / 9.0)));
-  double factor = 1.0;
-  for (Eigen::Index l = 1; l <= bandwidth && l < n; ++l)
-    factor += 2.0 * (1.0 - static_cast<double>(l) / static_cast<double>(bandwidth + 1)) *
-              x.head(n - l).dot(x.tail(n - l)) / c0;
-  return std::max(1.0, factor);
-}
-
 // Hansen (2000): the 95 % critical value of the change point's likelihood ratio.
 constexpr double kChangePointCritical95 = 7.35;
 
@@ -129,15 +112,22 @@ std::optional<LocatedStep> locate_step(const FoldedRows& rows, Eigen::Index colu
   if (tried.empty()) return std::nullopt;
   const Tried& best = *std::max_element(tried.begin(), tried.end(),
                                         [](const Tried& x, const Tried& y) { return x.removed < y.removed; });
-  LocatedStep out{best.t0, best.previous, best.removed, best.previous, best.t0};
-  const double rss_min = std::max(e.squaredNorm() - best.removed, 0.0);
-  const double s2 = rss_min / static_cast<double>(r.w.rows()) * long_run_factor(e, order);
-  for (const Tried& t : tried) {
-    if (!(s2 > 0.0) || (best.removed - t.removed) / s2 > kChangePointCritical95) continue;
-    out.earliest_s = std::min(out.earliest_s, t.previous);
-    out.latest_s = std::max(out.latest_s, t.t0);
-  }
+  LocatedStep out{best.t0, best.previous, best.removed, best.previous, best.t0, {}, 0.0, r.w.rows()};
+  out.rss_min = std::max(e.squaredNorm() - best.removed, 0.0);
+  for (const Tried& t : tried) out.tried.push_back({t.t0, t.previous, t.removed});
   return out;
+}
+
+void set_interval(LocatedStep& step, double inflation) {
+  const double scale = std::isfinite(inflation) ? std::max(inflation, 1.0) : 1.0;
+  const double s2 = step.rss_min / static_cast<double>(std::max<Eigen::Index>(step.rows, 1)) * scale;
+  step.earliest_s = step.previous_row_s;
+  step.latest_s = step.time_s;
+  for (const LocatedStep::Time& t : step.tried) {
+    if (!(s2 > 0.0) || (step.ss_removed - t.removed) / s2 > kChangePointCritical95) continue;
+    step.earliest_s = std::min(step.earliest_s, t.previous_row_s);
+    step.latest_s = std::max(step.latest_s, t.time_s);
+  }
 }
 
 std::string events_near(const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz, double from_s,

@@ -166,6 +166,7 @@ CandidateScore score(const Candidate& c, const detail::FoldedRows& rows, const s
   if (s.columns == 1) {
     s.coefficient = after.all.value(rows.last_effect_first);
     s.coefficient_std = wald.first_std;
+    s.coefficient_textbook_std = after.all.standard_deviation(rows.last_effect_first);
     s.coefficient_unit = rows.parameters[static_cast<std::size_t>(rows.last_effect_first)].unit;
     const Eigen::VectorXd alias =
         detail::regress_column(rows, rows.last_effect_first, base_columns, after.estimator_weights);
@@ -344,27 +345,60 @@ void locate_offset(CandidateScore& c, const SignalContext& in, const std::string
   c.finding = offset_finding(channel, unit, value, at_value.coefficient_std);
 }
 
-// The delay with the least in-sample weighted residual per row, within +-max samples: steps of
-// 2 samples, then the neighbours of the best.
-Eigen::Index locate_delay(const SignalContext& in, const std::string& channel, Eigen::Index max) {
-  const auto cost = [&](Eigen::Index samples) {
-    const detail::FoldedRows rows = detail::fold_rows(
+// The delay with the least in-sample weighted residual per row within +-max samples (steps of
+// 2 samples, then the neighbours of the best), with the cost of every delay tried.
+struct DelayProfile {
+  Eigen::Index samples = 0;
+  std::map<Eigen::Index, double> cost;  ///< weighted in-sample residual per row
+  std::uint64_t rows = 1;
+};
+
+DelayProfile profile_delay(const SignalContext& in, const std::string& channel, Eigen::Index max) {
+  DelayProfile out;
+  const auto consider = [&](Eigen::Index samples) {
+    if (out.cost.count(samples) != 0) return;
+    const detail::FoldedRows folded = detail::fold_rows(
         in.model, samples == 0 ? in.declared : with_delay(in.declared, channel, samples, in.rate), in.run, in.rate,
         in.odmf, in.fit, false, &in.rows);
-    const detail::Evaluation e = detail::evaluate(rows, {}, in.weights);
-    return e.weighted_in() / static_cast<double>(std::max<std::uint64_t>(e.total_rows(), 1));
+    const detail::Evaluation e = detail::evaluate(folded, {}, in.weights);
+    out.rows = std::max<std::uint64_t>(e.total_rows(), 1);
+    out.cost[samples] = e.weighted_in() / static_cast<double>(out.rows);
   };
-  Eigen::Index best = 0;
-  double best_cost = cost(0);
-  const auto consider = [&](Eigen::Index samples) {
-    const double c = cost(samples);
-    if (c < best_cost) best_cost = c, best = samples;
+  const auto best = [&] {
+    return std::min_element(out.cost.begin(), out.cost.end(),
+                            [](const auto& a, const auto& b) { return a.second < b.second; })->first;
   };
   for (Eigen::Index l = -max; l <= max; l += 2) consider(l);
-  const Eigen::Index coarse = best;
+  const Eigen::Index coarse = best();
   consider(coarse - 1);
   consider(coarse + 1);
-  return best;
+  out.samples = best();
+  return out;
+}
+
+// The 95 % profile-likelihood interval of the delay: the delays tried whose likelihood ratio
+// against the best, n (cost / best - 1), divided by `inflation`, stays within chi-square(1)'s
+// 3.84. `inflation` is how much the rows' correlation inflates the variance along the delay
+// (the score column's HAC variance over its textbook one at the delay found, at least 1: no row
+// counts for more than one): the robust likelihood ratio of a quasi-likelihood. Why not the score column's std alone (Gauss-Newton):
+// it ignores that the delay is found on the raw grid and that the cost is not quadratic over a
+// few samples; it said 190 +- 1 ms for a speed 200 ms late.
+struct LocatedDelay {
+  Eigen::Index samples = 0;
+  Eigen::Index earliest = 0, latest = 0;  ///< the interval, samples
+};
+
+LocatedDelay delay_interval(const DelayProfile& p, double inflation) {
+  constexpr double kChiSquare1At95 = 3.841;
+  LocatedDelay out{p.samples, p.samples, p.samples};
+  const double best = p.cost.at(p.samples);
+  const double scale = std::isfinite(inflation) ? std::max(inflation, 1.0) : 1.0;
+  for (const auto& [samples, c] : p.cost) {
+    if (!(best > 0.0) || static_cast<double>(p.rows) * (c / best - 1.0) / scale > kChiSquare1At95) continue;
+    out.earliest = std::min(out.earliest, samples);
+    out.latest = std::max(out.latest, samples);
+  }
+  return out;
 }
 
 std::string seconds_text(double t) {
@@ -387,6 +421,15 @@ std::string step_finding(const std::string& parameter, const CandidateScore& c, 
   const std::string events = detail::events_near(in.run, in.rate, step.earliest_s, step.latest_s, 2.0);
   if (!events.empty()) out += "; near it: " + events;
   return out;
+}
+
+// "steer is 120 ms late (95 % interval of its delay: +115 to +125 ms)"; a negative delay is early.
+std::string delay_finding(const std::string& channel, Eigen::Index samples, double from_s, double to_s, double rate) {
+  char text[200];
+  std::snprintf(text, sizeof text, "%s is %.0f ms %s (95 %% interval of its delay: %+.0f to %+.0f ms)", channel.c_str(),
+                std::abs(static_cast<double>(samples)) * 1000.0 / rate, samples >= 0 ? "late" : "early", 1000.0 * from_s,
+                1000.0 * to_s);
+  return text;
 }
 
 // The best significant step of each parameter (ranked) moved from its block boundary to the
@@ -413,9 +456,11 @@ void locate_significant_steps(ScreenResult& result, const SignalContext& in) {
                                  in.weights, in.odmf);
     again.significant = c.significant;
     again.detectable = c.detectable;
-    again.finding = step_finding(v.parameter, again, *step, in);
-    again.located_from_s = step->earliest_s;
-    again.located_to_s = step->latest_s;
+    detail::LocatedStep change = *step;
+    detail::set_interval(change, std::pow(again.coefficient_std / again.coefficient_textbook_std, 2));
+    again.finding = step_finding(v.parameter, again, change, in);
+    again.located_from_s = change.earliest_s;
+    again.located_to_s = change.latest_s;
     c = std::move(again);
   }
 }
@@ -592,25 +637,26 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
   for (CandidateScore& c : result.candidates)
     if (c.significant && c.kind == CandidateKind::kSensor && c.effect.find('@') == std::string::npos)
       locate_offset(c, delays, offset_units.at(c.effect.substr(std::string("offset:").size())));
-  // A significant delay is located and offered under its name (delay:steer@80ms), with the
-  // score column's standard deviation as the delay's.
+  // A significant delay is located and offered under its name (delay:steer@80ms), with its
+  // profile-likelihood interval.
   for (CandidateScore& c : result.candidates) {
     if (!c.significant || c.effect.rfind("delay:", 0) != 0 || c.effect.find('@') != std::string::npos) continue;
     const std::string channel = c.effect.substr(6);
     const auto max = static_cast<Eigen::Index>(std::llround(options.max_delay_s * sample_rate_hz));
-    const Eigen::Index found = locate_delay(delays, channel, max);
-    const double ms_per_sample = 1000.0 / sample_rate_hz;
-    // The delay's std: the score column's at the delay found, refitted there.
-    const detail::FoldedRows at_found = detail::fold_rows(model, with_delay(declared, channel, found, sample_rate_hz),
+    const DelayProfile profile = profile_delay(delays, channel, max);
+    const detail::FoldedRows at_found = detail::fold_rows(model, with_delay(declared, channel, profile.samples, sample_rate_hz),
                                                           run, sample_rate_hz, odmf, fold_options, false, &declared_rows);
     const Eigen::VectorXd x_found = detail::base_solution(detail::evaluate(at_found, {}, weights).all);
-    const double std_ms = ms_per_sample * score_delay(delays, channel, x_found, found).coefficient_std;
-    rescore_with(c, delays, delay_effect_name(channel, found, sample_rate_hz));
-    c.effect = delay_effect_name(channel, found, sample_rate_hz);
-    char text[160];
-    std::snprintf(text, sizeof text, "%s is %.0f +- %.0f ms %s", channel.c_str(), std::abs(static_cast<double>(found) * ms_per_sample),
-                  std_ms, found >= 0 ? "late" : "early");
-    c.finding = text;
+    const CandidateScore along = score_delay(delays, channel, x_found, profile.samples);
+    const double inflation = std::pow(along.coefficient_std / along.coefficient_textbook_std, 2);
+    const LocatedDelay found = delay_interval(profile, inflation);
+    rescore_with(c, delays, delay_effect_name(channel, found.samples, sample_rate_hz));
+    c.effect = delay_effect_name(channel, found.samples, sample_rate_hz);
+    // The delays are tried on the raw grid: a true delay between two samples rounds to one of
+    // them, so the interval reaches half a sample beyond the delays it keeps.
+    c.located_from_s = (static_cast<double>(found.earliest) - 0.5) / sample_rate_hz;
+    c.located_to_s = (static_cast<double>(found.latest) + 0.5) / sample_rate_hz;
+    c.finding = delay_finding(channel, found.samples, c.located_from_s, c.located_to_s, sample_rate_hz);
   }
   std::stable_sort(result.candidates.begin(), result.candidates.end(), ranks_before);
   if (options.varying_parameters) {

@@ -91,6 +91,9 @@ struct CandidateScore {
   int hac_lags = 0;               ///< Newey-West bandwidth (decimated rows)
   double coefficient = 0.0;       ///< the added column's coefficient, when it adds one
   double coefficient_std = 0.0;   ///< its HAC standard deviation
+  /// Its std counting every row as independent (textbook): the HAC one over it is how much the
+  /// rows' correlation inflates it.
+  double coefficient_textbook_std = 0.0;
   double held_out_rms_before = 0.0;  ///< weighted
   double held_out_rms_after = 0.0;
   double held_out_drop = 0.0;        ///< 1 - after / before
@@ -101,7 +104,8 @@ struct CandidateScore {
   /// What a located candidate found, in an engineer's words (a delay: "steer is 80 +- 4 ms
   /// late"); empty for the others.
   std::string finding;
-  /// A located step's 95 % confidence set for its time, s of run time (hull; NaN otherwise).
+  /// A located candidate's 95 % set (hull; NaN for the others): a step's time, s of run time; a
+  /// delay's value, s (positive: late).
   double located_from_s = std::numeric_limits<double>::quiet_NaN();
   double located_to_s = std::numeric_limits<double>::quiet_NaN();
   bool significant = false;
