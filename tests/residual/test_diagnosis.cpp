@@ -318,6 +318,7 @@ TEST(SensorOffset, NamesParseAndTheAngleAnAccelerometerOffsetMeans) {
   EXPECT_TRUE(is_mounted_sensor("yaw_rate", "rad/s"));
   EXPECT_TRUE(is_mounted_sensor("ax", "m/s^2"));
   EXPECT_FALSE(is_mounted_sensor("engine_speed", "rad/s"));
+  EXPECT_FALSE(is_mounted_sensor("d_vx", "m/s^2"));
 }
 
 // A sensor scale that grows with the speed (a parameter that depends on a channel): explained

@@ -336,6 +336,8 @@ void locate_offset(CandidateScore& c, const SignalContext& in, const std::string
                                                       in.rate, in.odmf, in.fit, false, &in.rows);
     const Eigen::VectorXd x = detail::base_solution(detail::evaluate(rows, {}, in.weights).all);
     at_value = score_offset(in, channel, unit, x, value);
+    // Not identifiable at this offset: the candidate stays as the screen scored it, unnamed.
+    if (!at_value.testable || !std::isfinite(at_value.coefficient)) return;
     value += at_value.coefficient;
   }
   rescore_with(c, in, offset_effect_name(channel, value));
@@ -635,7 +637,8 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
   }
   decide(result, options.family_error_rate);
   for (CandidateScore& c : result.candidates)
-    if (c.significant && c.kind == CandidateKind::kSensor && c.effect.find('@') == std::string::npos)
+    if (c.significant && c.kind == CandidateKind::kSensor && c.effect.find('@') == std::string::npos &&
+        std::isfinite(c.coefficient))
       locate_offset(c, delays, offset_units.at(c.effect.substr(std::string("offset:").size())));
   // A significant delay is located and offered under its name (delay:steer@80ms), with its
   // profile-likelihood interval.

@@ -41,6 +41,7 @@ std::string offset_effect_name(const std::string& channel, double value) {
 }
 
 bool is_mounted_sensor(const std::string& channel, const std::string& unit) {
+  if (channel.rfind("d_", 0) == 0) return false;  // a derivative the preprocessing makes, no sensor
   return unit == "m/s^2" || (unit == "rad/s" && ends_with(channel, "_rate"));
 }
 

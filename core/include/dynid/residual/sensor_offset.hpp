@@ -34,7 +34,8 @@ SensorOffset parse_offset_effect(const std::string& name);
 /// The effect's name (the value with 6 significant digits).
 std::string offset_effect_name(const std::string& channel, double value);
 
-/// True for the channels whose offset the screen tests (see above), by name and unit.
+/// True for the channels whose offset the screen tests (see above), by name and unit; never a
+/// derivative d_<x> (in m/s^2 when x is a speed, but made by the preprocessing, not measured).
 bool is_mounted_sensor(const std::string& channel, const std::string& unit);
 
 /// "ay reads +0.171 +- 0.010 m/s^2 too much: the accelerometer rolled +1.00 +- 0.06 deg on its
