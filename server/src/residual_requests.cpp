@@ -124,6 +124,12 @@ residual::IvFit iv_of(const model::Model& model, const std::vector<std::string>&
                           options);
 }
 
+residual::SimexFit simex_of(const model::Model& model, const std::vector<std::string>& effects,
+                            const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments) {
+  const auto noise = residual::measure_channel_noise(run, segments, run.announcement.preprocessing.channel_noise);
+  return residual::simex_fit(model, effects, run, segments, noise);
+}
+
 std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& announcement,
                                                  const std::vector<ingest::Chunk>& chunks,
                                                  const std::vector<std::string>& models) {
@@ -155,7 +161,16 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
     } catch (const InputError&) {
       // No row yet: no IV estimate (a refusal for weak instruments is a result, not this).
     }
-    if (!verdict.verdict.empty() || verdict.iv) out[spec.model] = std::move(verdict);
+    // SIMEX only where the table will stay least squares': where IV replaces it, the correction
+    // would not be published, and it costs the most of the three (2 x lambdas x draws refits).
+    if (!verdict.iv || !verdict.iv->replaces_least_squares()) {
+      try {
+        verdict.simex = simex_of(*model, spec.effects, run, segments);
+      } catch (const InputError&) {
+        // No row yet: no correction.
+      }
+    }
+    if (!verdict.verdict.empty() || verdict.iv || verdict.simex) out[spec.model] = std::move(verdict);
   }
   return out;
 }
