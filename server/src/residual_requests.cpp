@@ -124,9 +124,14 @@ residual::IvFit iv_of(const model::Model& model, const std::vector<std::string>&
                           options);
 }
 
+std::vector<residual::ChannelNoise> run_noise(const ingest::RecordedRun& run,
+                                              const std::vector<ingest::PreprocessedSegment>& segments) {
+  return residual::measure_channel_noise(run, segments, run.announcement.preprocessing.channel_noise);
+}
+
 residual::SimexFit simex_of(const model::Model& model, const std::vector<std::string>& effects,
-                            const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments) {
-  const auto noise = residual::measure_channel_noise(run, segments, run.announcement.preprocessing.channel_noise);
+                            const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
+                            const std::vector<residual::ChannelNoise>& noise) {
   return residual::simex_fit(model, effects, run, segments, noise);
 }
 
@@ -139,6 +144,7 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
   if (segments.empty()) return out;
   residual::DiagnosisOptions options;
   options.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
+  std::optional<std::vector<residual::ChannelNoise>> noise;  // measured once, when a model needs it
   for (const ingest::ModelSpec& spec : announcement.models) {
     if (std::find(models.begin(), models.end(), spec.model) == models.end()) continue;
     LiveVerdict verdict;
@@ -165,7 +171,8 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
     // would not be published, and it costs the most of the three (2 x lambdas x draws refits).
     if (!verdict.iv || !verdict.iv->replaces_least_squares()) {
       try {
-        verdict.simex = simex_of(*model, spec.effects, run, segments);
+        if (!noise) noise = run_noise(run, segments);
+        verdict.simex = simex_of(*model, spec.effects, run, segments, *noise);
       } catch (const InputError&) {
         // No row yet: no correction.
       }

@@ -75,12 +75,18 @@ residual::IvFit iv_of(const model::Model& model, const std::vector<std::string>&
                       const ingest::RunAnnouncement& announcement,
                       const std::vector<ingest::PreprocessedSegment>& segments);
 
-/// The SIMEX fit of a model on a run (`run` assembled, `segments` = preprocess_offline(run)), as
-/// the live judgement takes it: each channel's noise measured above the cut-off or declared by
-/// the profile (the announcement's channel_noise), SimexOptions' defaults (seed 1: a stored run
-/// gives the same values every time it is fitted).
+/// The channel noise SIMEX corrects for on a run (`run` assembled, `segments` =
+/// preprocess_offline(run)): measured above the cut-off, or declared by the profile (the
+/// announcement's channel_noise). Once per run: every model's fit shares it.
+std::vector<residual::ChannelNoise> run_noise(const ingest::RecordedRun& run,
+                                              const std::vector<ingest::PreprocessedSegment>& segments);
+
+/// The SIMEX fit of a model on a run with the run's noise (run_noise), as the live judgement
+/// takes it: SimexOptions' defaults (seed 1: a stored run gives the same values every time it is
+/// fitted).
 residual::SimexFit simex_of(const model::Model& model, const std::vector<std::string>& effects,
-                            const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments);
+                            const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
+                            const std::vector<residual::ChannelNoise>& noise);
 
 /// The verdict of each of `models` (announced models, with their declared effects) on the run so
 /// far: what a server started with --live-residual publishes beside the estimates. A model that
