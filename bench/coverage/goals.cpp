@@ -61,12 +61,45 @@ std::string iv_verdicts(const std::vector<ParameterCoverage>& rows) {
   return out;
 }
 
+namespace {
+
+// One verdict line of an estimate of row r: "- model parameter <how>: <std verdict>; <accuracy>".
+std::string estimate_line(const ParameterCoverage& r, const std::string& how, const char* which, const StdCoverage& c,
+                          double mean_error_pct, const std::vector<double>& errors_pct) {
+  return "- " + r.model + " " + r.parameter + " " + how + ": " + std_verdict(which, c) + "; " +
+         accuracy_verdict(r.parameter, mean_error_pct, errors_pct) + "\n";
+}
+
+}  // namespace
+
 std::string published_verdicts(const std::vector<ParameterCoverage>& rows) {
   std::string out;
-  for (const ParameterCoverage& r : rows)
-    out += "- " + r.model + " " + r.parameter + " as published (" + std::to_string(r.published.by_iv) + " of " +
-           std::to_string(r.published.seeds) + " seeds by IV): " + std_verdict("published", r.published.std) + "; " +
-           accuracy_verdict(r.parameter, r.published.mean_error_pct, r.published.errors_pct) + "\n";
+  for (const ParameterCoverage& r : rows) {
+    const PublishedCoverage& p = r.published;
+    out += estimate_line(r, "as published (" + std::to_string(p.by_iv) + " of " + std::to_string(p.seeds) + " seeds by IV)",
+                         "published", p.std, p.mean_error_pct, p.errors_pct);
+  }
+  return out;
+}
+
+std::string simex_verdicts(const std::vector<ParameterCoverage>& rows) {
+  std::string out;
+  for (const ParameterCoverage& r : rows) {
+    const SimexCoverage& s = r.simex;
+    out += estimate_line(r, "by SIMEX (" + std::to_string(s.corrected) + " of " + std::to_string(s.seeds) + " seeds corrected)",
+                         "SIMEX", s.std, s.mean_error_pct, s.errors_pct);
+  }
+  return out;
+}
+
+std::string proposed_verdicts(const std::vector<ParameterCoverage>& rows) {
+  std::string out;
+  for (const ParameterCoverage& r : rows) {
+    const PublishedCoverage& p = r.proposed;
+    out += estimate_line(r, "as proposed (" + std::to_string(p.by_iv) + " by IV, " + std::to_string(p.by_simex) +
+                                " by SIMEX of " + std::to_string(p.seeds) + " seeds)",
+                         "proposed", p.std, p.mean_error_pct, p.errors_pct);
+  }
   return out;
 }
 

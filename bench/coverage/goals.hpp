@@ -25,4 +25,10 @@ std::string iv_verdicts(const std::vector<ParameterCoverage>& rows);
 /// The same for what the product's table publishes (IV where the bias test rejects LS).
 std::string published_verdicts(const std::vector<ParameterCoverage>& rows);
 
+/// The same for the SIMEX estimate.
+std::string simex_verdicts(const std::vector<ParameterCoverage>& rows);
+
+/// The same for the proposed published estimate (IV where DWH rejects, else SIMEX where it improves).
+std::string proposed_verdicts(const std::vector<ParameterCoverage>& rows);
+
 }  // namespace dynid::benchcoverage

@@ -17,7 +17,9 @@ nlohmann::json sample_json(const ParameterSample& s) {
           {"value", number(s.value)}, {"std", number(s.std)},     {"hac_value", number(s.hac_value)},
           {"hac_std", number(s.hac_std)},     {"iv_value", number(s.iv_value)}, {"iv_std", number(s.iv_std)},
           {"iv_hac_std", number(s.iv_hac_std)}, {"dwh_rejects", s.dwh_rejects}, {"iv_refused", s.iv_refused},
-          {"iv_instrument_f", number(s.iv_instrument_f)}};
+          {"iv_instrument_f", number(s.iv_instrument_f)}, {"simex_value", number(s.simex_value)},
+          {"simex_std", number(s.simex_std)}, {"simex_mc_std", number(s.simex_mc_std)},
+          {"simex_corrected", s.simex_corrected}, {"simex_improves", s.simex_improves}};
 }
 
 nlohmann::json run_json(const SeedRun& r) {
@@ -36,6 +38,15 @@ nlohmann::json std_json(const StdCoverage& c) {
           {"mean_error_over_std", number(c.error_over_std)}};
 }
 
+nlohmann::json published_json(const PublishedCoverage& c) {
+  return {{"seeds", c.seeds},
+          {"by_iv", c.by_iv},
+          {"by_simex", c.by_simex},
+          {"mean_error_pct", number(c.mean_error_pct)},
+          {"scatter_pct", number(c.scatter_pct)},
+          {"std", std_json(c.std)}};
+}
+
 nlohmann::json row_json(const ParameterCoverage& r) {
   return {{"model", r.model},
           {"parameter", r.parameter},
@@ -52,7 +63,16 @@ nlohmann::json row_json(const ParameterCoverage& r) {
             {"scatter_pct", number(r.iv.scatter_pct)},
             {"textbook", std_json(r.iv.textbook)},
             {"hac", std_json(r.iv.hac)},
-            {"dwh_rejections", number(r.iv.dwh_rejections)}}}};
+            {"dwh_rejections", number(r.iv.dwh_rejections)}}},
+          {"simex",
+           {{"seeds", r.simex.seeds},
+            {"corrected", r.simex.corrected},
+            {"mean_error_pct", number(r.simex.mean_error_pct)},
+            {"scatter_pct", number(r.simex.scatter_pct)},
+            {"mean_monte_carlo_std_pct", number(r.simex.mean_monte_carlo_std_pct)},
+            {"std", std_json(r.simex.std)}}},
+          {"published", published_json(r.published)},
+          {"proposed", published_json(r.proposed)}};
 }
 
 }  // namespace

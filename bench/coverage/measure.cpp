@@ -6,17 +6,39 @@
 
 #include "car/clean_run.hpp"
 #include "car/declared_fit.hpp"
+#include "car/product_path.hpp"
+#include "dynid/model/registry.hpp"
+#include "dynid/residual/noise_floor.hpp"
+#include "dynid/residual/simex.hpp"
 
 namespace dynid::benchcoverage {
 namespace {
 
+// The model as declared, corrected by SIMEX for the noise the product measures on the run (the
+// profile's declared sensors in place of their measurement), as the server would. The draws are
+// seeded by the run's seed: with one seed for every run the Monte Carlo error would be common to
+// all the runs of a manoeuvre, a bias of the benchmark's mean rather than a scatter.
+residual::SimexFit declared_simex(const car::VehicleProfile& profile, const std::string& model,
+                                  const benchcar::CleanRun& run, std::uint64_t seed, int draws) {
+  const ingest::ModelSpec spec = benchcar::model_spec(profile, model);
+  const auto m = model::make_model(spec.model, spec.constants);
+  const ingest::RecordedRun& recorded = run.product.recorded;
+  const auto noise =
+      residual::measure_channel_noise(recorded, run.segments, recorded.announcement.preprocessing.channel_noise);
+  residual::SimexOptions options;
+  options.draws = draws;
+  options.seed = seed;
+  return residual::simex_fit(*m, spec.effects, recorded, run.segments, noise, options);
+}
+
 // Each parameter of one model that has a truth on this run, with both std. The parameter order
 // of the two fits is the model's (one fold of the same rows), checked by name all the same.
 void add_model(const car::VehicleProfile& profile, const std::string& model, const benchcar::CleanRun& run,
-               std::vector<ParameterSample>& out) {
+               std::uint64_t seed, int simex_draws, std::vector<ParameterSample>& out) {
   const residual::ModelFit fit = benchcar::declared_fit(profile, model, run.product.recorded, run.segments);
   const residual::ModelParameters hac = benchcar::declared_hac(profile, model, run.product.recorded, run.segments);
   const residual::IvFit iv = benchcar::declared_iv(profile, model, run.product.recorded, run.segments);
+  const residual::SimexFit simex = declared_simex(profile, model, run, seed, simex_draws);
   for (std::size_t i = 0; i < fit.parameters.size(); ++i) {
     const std::string& name = fit.parameters[i].name;
     const auto truth = run.truth.parameters.find(name);
@@ -37,6 +59,13 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
       s.iv_std = iv.std(k);
       s.iv_hac_std = iv.hac_std(k);
     }
+    if (i < simex.parameters.size() && simex.parameters[i].name == name) {
+      s.simex_value = simex.value(k);
+      s.simex_std = simex.std(k);
+      s.simex_mc_std = simex.monte_carlo_std(k);
+      s.simex_improves = simex.improves(k);
+      s.simex_corrected = simex.corrected();
+    }
     s.dwh_rejects = iv.dwh.rejects;
     s.iv_instrument_f = iv.instrument_f;
     s.iv_refused = iv.reason;
@@ -49,6 +78,8 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
 double ParameterSample::relative_error() const { return (value - truth) / std::abs(truth); }
 
 double ParameterSample::iv_relative_error() const { return (iv_value - truth) / std::abs(truth); }
+
+double ParameterSample::simex_relative_error() const { return (simex_value - truth) / std::abs(truth); }
 
 const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre) {
   static const std::vector<std::string> longitudinal = {"longitudinal_wheel", "longitudinal_engine"};
@@ -65,14 +96,14 @@ const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre) {
 }
 
 SeedRun measure_seed(const car::VehicleProfile& profile, benchcar::Manoeuvre manoeuvre, std::uint64_t seed,
-                     double noise_scale, const std::filesystem::path& work_dir) {
+                     double noise_scale, const std::filesystem::path& work_dir, int simex_draws) {
   const auto t0 = std::chrono::steady_clock::now();
   SeedRun r;
   r.manoeuvre = manoeuvre;
   r.seed = seed;
   try {
     const benchcar::CleanRun run = benchcar::clean_run(profile, manoeuvre, seed, noise_scale, work_dir);
-    for (const std::string& model : models_of(manoeuvre)) add_model(profile, model, run, r.samples);
+    for (const std::string& model : models_of(manoeuvre)) add_model(profile, model, run, seed, simex_draws, r.samples);
   } catch (const std::exception& e) {
     r.error = e.what();
   }

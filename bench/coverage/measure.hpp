@@ -4,7 +4,9 @@
 // the profile declares it, and for each parameter with a known truth its value with the two
 // standard deviations the product reports (car/declared_fit.hpp): the estimate table's (DYCARO's
 // weighted LS) and the HAC one of `dynid consistency`; and the instrumental-variable estimate
-// (residual::iv_fit) with its std and the Durbin-Wu-Hausman test against LS.
+// (residual::iv_fit) with its std and the Durbin-Wu-Hausman test against LS; and the SIMEX
+// correction of LS (residual::simex_fit) for the channels' noise as the product measures it
+// (measure_channel_noise, the profile's declared sensors replacing their measurement).
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -34,10 +36,17 @@ struct ParameterSample {
   bool dwh_rejects = false; ///< the model's Durbin-Wu-Hausman test rejects at 1 %
   double iv_instrument_f = kNaN;  ///< the model's Cragg-Donald F (weak-instrument check)
   std::string iv_refused;   ///< the refusal's reason, empty when IV was estimated
+  /// SIMEX (residual::simex_fit): LS corrected for the measured noise of the channels it reads.
+  double simex_value = kNaN;
+  double simex_std = kNaN;     ///< sqrt(LS HAC^2 + Monte Carlo^2 + noise level^2)
+  double simex_mc_std = kNaN;  ///< its Monte Carlo part
+  bool simex_improves = false;  ///< residual::SimexFit::improves: SIMEX's estimated MSE below LS's
+  bool simex_corrected = false;  ///< some channel's noise reaches the rows
   /// (value - truth) / |truth|: relative, so that a negative truth (the clutch's viscous slope)
   /// keeps the error's sign.
   double relative_error() const;
   double iv_relative_error() const;
+  double simex_relative_error() const;
 };
 
 struct SeedRun {
@@ -51,9 +60,9 @@ struct SeedRun {
 /// The models identified on a manoeuvre (docs/RESIDUAL.md "Benchmark on a second car").
 const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre);
 
-/// One clean run at `seed` (sensor noise times noise_scale) and its fits. Never throws: a failure
-/// is SeedRun::error.
+/// One clean run at `seed` (sensor noise times noise_scale) and its fits, SIMEX with
+/// `simex_draws` draws per lambda. Never throws: a failure is SeedRun::error.
 SeedRun measure_seed(const car::VehicleProfile& profile, benchcar::Manoeuvre manoeuvre, std::uint64_t seed,
-                     double noise_scale, const std::filesystem::path& work_dir);
+                     double noise_scale, const std::filesystem::path& work_dir, int simex_draws = 8);
 
 }  // namespace dynid::benchcoverage

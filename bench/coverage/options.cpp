@@ -12,7 +12,7 @@ namespace {
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr,
                "%s\nusage: dynid-bench-coverage [--seeds N] [--manoeuvres longitudinal,lateral,launch] [--json FILE]\n"
-               "                            [--noise SCALE] [--profile TOML] [--smoke]\n",
+               "                            [--noise SCALE] [--simex-draws B] [--profile TOML] [--smoke]\n",
                why.c_str());
   std::exit(2);
 }
@@ -41,6 +41,7 @@ Options parse_options(int argc, char** argv) {
     if (a == "--seeds") o.seeds = static_cast<int>(args.number(1, 1000));
     else if (a == "--manoeuvres") o.manoeuvres = manoeuvres_of(args.value());
     else if (a == "--noise") o.noise_scale = args.number(0, 10);
+    else if (a == "--simex-draws") o.simex_draws = static_cast<int>(args.number(2, 1000));
     else if (a == "--json") o.json = args.value();
     else if (a == "--profile") o.profile = args.value();
     else if (a == "--smoke") o.smoke = true;

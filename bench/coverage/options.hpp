@@ -12,6 +12,7 @@ struct Options {
   std::vector<benchcar::Manoeuvre> manoeuvres = {benchcar::Manoeuvre::kLongitudinal, benchcar::Manoeuvre::kLateral,
                                                  benchcar::Manoeuvre::kLaunch};
   double noise_scale = 1.0;  ///< the car's sensor noise times this (0: noise-free, to tell noise from model error)
+  int simex_draws = 8;  ///< SIMEX draws per lambda (residual::SimexOptions::draws)
   std::string json;  ///< per-seed values, empty: none
   std::string profile = DYNID_BENCHCAR_PROFILE;
   bool smoke = false;

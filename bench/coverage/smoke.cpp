@@ -33,6 +33,10 @@ std::vector<std::string> check_seed(const SeedRun& r) {
     if (!positive(s.iv_value) || !positive(s.iv_std) || !positive(s.iv_hac_std))
       failed.push_back(what + ": IV value or std not finite and positive");
     if (!(std::abs(s.iv_relative_error()) <= kErrorBound)) failed.push_back(what + ": IV error above 5 %");
+    if (!s.simex_corrected) failed.push_back(what + ": SIMEX corrected nothing: no measured noise reached the rows");
+    if (!positive(s.simex_value) || !positive(s.simex_std) || !(s.simex_mc_std >= 0.0 && s.simex_mc_std < s.simex_std))
+      failed.push_back(what + ": SIMEX value or std not finite and positive");
+    if (!(std::abs(s.simex_relative_error()) <= kErrorBound)) failed.push_back(what + ": SIMEX error above 5 %");
   }
   return failed;
 }

@@ -29,11 +29,26 @@ struct IvCoverage {
   double dwh_rejections = kNaN;  ///< share of the seeds (IV estimated) where DWH rejects at 1 %
 };
 
-/// What the product's table publishes (server/estimate_tables.hpp apply_iv): IV's value and HAC
-/// std where the model's Durbin-Wu-Hausman test rejects least squares at 1 %, else the table's.
+/// SIMEX (residual::simex_fit) over the same seeds: LS corrected for the measured noise.
+struct SimexCoverage {
+  int seeds = 0;      ///< seeds with a finite SIMEX value and std
+  int corrected = 0;  ///< of which some channel's noise reached the rows
+  double mean_error_pct = kNaN;
+  double scatter_pct = kNaN;
+  double mean_monte_carlo_std_pct = kNaN;  ///< the Monte Carlo part of its std
+  std::vector<double> errors_pct;
+  StdCoverage std;    ///< sqrt(LS HAC^2 + Monte Carlo^2 + noise level^2)
+};
+
+/// What a table publishes. `published`: what the server publishes today (server/estimate_tables.hpp
+/// apply_iv): IV's value and HAC std where the model's Durbin-Wu-Hausman test rejects least
+/// squares at 1 %, else the table's. `proposed`: the same with SIMEX's value and std in place of
+/// the table's where SIMEX's estimated mean squared error is below LS's (SimexFit::improves;
+/// docs/ACCURACY.md says why).
 struct PublishedCoverage {
   int seeds = 0;     ///< seeds with a finite published value and std
   int by_iv = 0;     ///< of which by IV
+  int by_simex = 0;  ///< of which by SIMEX (proposed only)
   double mean_error_pct = kNaN;
   double scatter_pct = kNaN;
   std::vector<double> errors_pct;
@@ -51,7 +66,9 @@ struct ParameterCoverage {
   StdCoverage table;             ///< the estimate table's std
   StdCoverage hac;               ///< the HAC std
   IvCoverage iv;
+  SimexCoverage simex;
   PublishedCoverage published;
+  PublishedCoverage proposed;
 };
 
 /// One row per (model, parameter), in the order the runs first give them. A seed whose value or
@@ -64,7 +81,13 @@ std::string markdown_table(const std::vector<ParameterCoverage>& rows);
 /// The IV columns beside LS's mean error, as a markdown table.
 std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows);
 
+/// The SIMEX columns beside LS's and IV's mean error, as a markdown table.
+std::string simex_markdown_table(const std::vector<ParameterCoverage>& rows);
+
 /// The published estimate's columns, as a markdown table.
 std::string published_markdown_table(const std::vector<ParameterCoverage>& rows);
+
+/// The proposed published estimate's columns (IV where DWH rejects, else SIMEX where it improves).
+std::string proposed_markdown_table(const std::vector<ParameterCoverage>& rows);
 
 }  // namespace dynid::benchcoverage

@@ -27,42 +27,70 @@ dds::EstimateTable table_of(const std::string& vehicle, const std::string& sourc
 
 namespace {
 
-bool same_columns(const std::vector<model::ParameterInfo>& parameters, const residual::IvFit& iv) {
-  if (iv.parameters.size() != parameters.size() || iv.value.size() != static_cast<Eigen::Index>(parameters.size()))
+bool same_columns(const std::vector<model::ParameterInfo>& parameters,
+                  const std::vector<model::ParameterInfo>& fitted, const Eigen::VectorXd& value) {
+  if (fitted.size() != parameters.size() || value.size() != static_cast<Eigen::Index>(parameters.size()))
     return false;
   for (std::size_t k = 0; k < parameters.size(); ++k)
-    if (iv.parameters[k].name != parameters[k].name) return false;
+    if (fitted[k].name != parameters[k].name) return false;
   return true;
+}
+
+// The rows `replace` marks get `value` and `std` in place of least squares', which is kept beside
+// them; the statuses are classified again on the new values; the table names `estimator`.
+void replace_rows(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
+                  const ls::WeightedEstimate& estimate, const Eigen::VectorXd& value, const Eigen::VectorXd& std,
+                  const std::vector<bool>& replace, const char* estimator) {
+  ls::WeightedEstimate replaced = estimate;
+  ls::Estimate& e = replaced.estimate;
+  for (Eigen::Index j = 0; j < e.value.size(); ++j) {
+    if (!replace[static_cast<std::size_t>(j)]) continue;
+    e.value(j) = value(j);
+    e.standard_deviation(j) = std(j);
+    e.relative_std_percent(j) = 100.0 * std(j) / std::abs(value(j));
+  }
+  // Only the rows (and the model's note) change: the fit's figures stay least squares', whose
+  // residual the rows' weights come from.
+  dds::EstimateTable by = table_of(table.vehicle, table.source, table.model, parameters, replaced);
+  for (std::size_t k = 0; k < by.parameters.size(); ++k) {
+    if (!replace[k]) continue;
+    const auto j = static_cast<Eigen::Index>(k);
+    by.parameters[k].least_squares_value = estimate.estimate.value(j);
+    by.parameters[k].least_squares_std = estimate.estimate.standard_deviation(j);
+  }
+  table.parameters = std::move(by.parameters);
+  table.not_excited = std::move(by.not_excited);
+  table.estimator = estimator;
 }
 
 }  // namespace
 
 void apply_iv(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
               const ls::WeightedEstimate& estimate, const residual::IvFit& iv, std::uint64_t through) {
-  if (!same_columns(parameters, iv)) return;
+  if (!same_columns(parameters, iv.parameters, iv.value)) return;
   table.bias_test = iv.statement();
   table.bias_through = through;
   if (!iv.replaces_least_squares()) return;
-  ls::WeightedEstimate replaced = estimate;
-  ls::Estimate& e = replaced.estimate;
-  for (Eigen::Index j = 0; j < e.value.size(); ++j) {
-    if (!std::isfinite(iv.value(j)) || !std::isfinite(e.value(j))) continue;
-    e.value(j) = iv.value(j);
-    e.standard_deviation(j) = iv.hac_std(j);
-    e.relative_std_percent(j) = 100.0 * iv.hac_std(j) / std::abs(iv.value(j));
-  }
-  // Only the rows (and the model's note) change: the fit's figures stay least squares', whose
-  // residual the rows' weights come from.
-  dds::EstimateTable by_iv = table_of(table.vehicle, table.source, table.model, parameters, replaced);
-  for (std::size_t k = 0; k < by_iv.parameters.size(); ++k) {
+  std::vector<bool> replace(parameters.size());
+  for (std::size_t k = 0; k < replace.size(); ++k) {
     const auto j = static_cast<Eigen::Index>(k);
-    if (!std::isfinite(iv.value(j)) || !std::isfinite(estimate.estimate.value(j))) continue;
-    by_iv.parameters[k].least_squares_value = estimate.estimate.value(j);
-    by_iv.parameters[k].least_squares_std = estimate.estimate.standard_deviation(j);
+    replace[k] = std::isfinite(iv.value(j)) && std::isfinite(estimate.estimate.value(j));
   }
-  table.parameters = std::move(by_iv.parameters);
-  table.not_excited = std::move(by_iv.not_excited);
-  table.estimator = dds::kInstrumentalVariables;
+  replace_rows(table, parameters, estimate, iv.value, iv.hac_std, replace, dds::kInstrumentalVariables);
+}
+
+void apply_simex(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
+                 const ls::WeightedEstimate& estimate, const residual::SimexFit& simex) {
+  if (table.estimator != dds::kLeastSquares || !same_columns(parameters, simex.parameters, simex.value)) return;
+  std::vector<bool> replace(parameters.size());
+  bool any = false;
+  for (std::size_t k = 0; k < replace.size(); ++k) {
+    const auto j = static_cast<Eigen::Index>(k);
+    replace[k] = simex.improves(j) && std::isfinite(estimate.estimate.value(j)) &&
+                 table.parameters[k].status == ls::ParameterStatus::kIdentified;
+    any = any || replace[k];
+  }
+  if (any) replace_rows(table, parameters, estimate, simex.value, simex.std, replace, dds::kSimex);
 }
 
 EstimateTables tables_of(const std::string& vehicle, const std::string& source,

@@ -124,6 +124,17 @@ residual::IvFit iv_of(const model::Model& model, const std::vector<std::string>&
                           options);
 }
 
+std::vector<residual::ChannelNoise> run_noise(const ingest::RecordedRun& run,
+                                              const std::vector<ingest::PreprocessedSegment>& segments) {
+  return residual::measure_channel_noise(run, segments, run.announcement.preprocessing.channel_noise);
+}
+
+residual::SimexFit simex_of(const model::Model& model, const std::vector<std::string>& effects,
+                            const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
+                            const std::vector<residual::ChannelNoise>& noise) {
+  return residual::simex_fit(model, effects, run, segments, noise);
+}
+
 std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& announcement,
                                                  const std::vector<ingest::Chunk>& chunks,
                                                  const std::vector<std::string>& models) {
@@ -133,6 +144,7 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
   if (segments.empty()) return out;
   residual::DiagnosisOptions options;
   options.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
+  std::optional<std::vector<residual::ChannelNoise>> noise;  // measured once, when a model needs it
   for (const ingest::ModelSpec& spec : announcement.models) {
     if (std::find(models.begin(), models.end(), spec.model) == models.end()) continue;
     LiveVerdict verdict;
@@ -155,7 +167,17 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
     } catch (const InputError&) {
       // No row yet: no IV estimate (a refusal for weak instruments is a result, not this).
     }
-    if (!verdict.verdict.empty() || verdict.iv) out[spec.model] = std::move(verdict);
+    // SIMEX only where the table will stay least squares': where IV replaces it, the correction
+    // would not be published, and it costs the most of the three (2 x lambdas x draws refits).
+    if (!verdict.iv || !verdict.iv->replaces_least_squares()) {
+      try {
+        if (!noise) noise = run_noise(run, segments);
+        verdict.simex = simex_of(*model, spec.effects, run, segments, *noise);
+      } catch (const InputError&) {
+        // No row yet: no correction.
+      }
+    }
+    if (!verdict.verdict.empty() || verdict.iv || verdict.simex) out[spec.model] = std::move(verdict);
   }
   return out;
 }

@@ -515,11 +515,11 @@ void RunService::attach_live(const RunState& run, const std::vector<ingest::Mode
       table.residual_statement = live.statement;
       table.residual_through = through;
     }
-    if (!live.iv) continue;
     const auto estimate = std::find_if(estimates.begin(), estimates.end(),
                                        [&](const ingest::ModelEstimate& e) { return e.model == table.model; });
-    if (estimate != estimates.end() && estimate->estimate)
-      apply_iv(table, estimate->parameters, *estimate->estimate, *live.iv, through);
+    if (estimate == estimates.end() || !estimate->estimate) continue;
+    if (live.iv) apply_iv(table, estimate->parameters, *estimate->estimate, *live.iv, through);
+    if (live.simex) apply_simex(table, estimate->parameters, *estimate->estimate, *live.simex);
   }
 }
 

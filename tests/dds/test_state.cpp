@@ -183,6 +183,12 @@ TEST(DdsState, TheEstimatorAndTheLeastSquaresValuesItReplacesCrossTheWire) {
   EXPECT_EQ(back.estimator, kLeastSquares);
   EXPECT_TRUE(std::isnan(back.parameters[0].least_squares_value));
   EXPECT_TRUE(std::isnan(back.parameters[0].least_squares_std));
+  // SIMEX rows carry the least-squares value they replace in the same members.
+  t.estimator = kSimex;
+  back = from_wire(to_wire(t).data);
+  EXPECT_EQ(back.estimator, kSimex);
+  EXPECT_EQ(back.parameters[0].least_squares_value, 3101.5);
+  EXPECT_EQ(back.parameters[0].least_squares_std, 4.25);
 }
 
 }  // namespace

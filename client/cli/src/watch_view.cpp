@@ -60,7 +60,10 @@ std::string WatchView::text(const dds::EstimateTable& t) {
   if (!t.not_excited.empty()) return out + "  not excited by this run: " + t.not_excited + "\n";
   if (!t.residual_verdict.empty())
     out += fmt::format("  residual (chunks through #{}): {}\n", t.residual_through, t.residual_verdict);
-  if (t.estimator != dds::kLeastSquares)
+  if (t.estimator == dds::kSimex)
+    out += fmt::format("  values by SIMEX (chunks through #{}): least squares corrected for the sensor noise\n",
+                       t.bias_through);
+  else if (t.estimator != dds::kLeastSquares)
     out += fmt::format("  values by {} (chunks through #{}): least squares is biased on this run\n", t.estimator,
                        t.bias_through);
   out += fmt::format("  {:<26} {:>12} {:>11} {:>8}  {:<17}  {}\n", "parameter", "value", "std",

@@ -214,7 +214,7 @@ EstimateTable from_wire(const dynid_wire_Estimate& sample) {
   table.residual_through = sample.residual_through;
   table.estimator = get(sample.estimator, where + " estimator");
   if (table.estimator.empty()) table.estimator = kLeastSquares;  // an older server's
-  if (table.estimator != kInstrumentalVariables)  // an older server sends zeros there
+  if (table.estimator == kLeastSquares)  // an older server sends zeros there
     for (ParameterEntry& p : table.parameters) p.least_squares_value = p.least_squares_std = std::nan("");
   table.bias_test = get(sample.bias_test, where + " bias_test");
   table.bias_through = sample.bias_through;

@@ -62,7 +62,9 @@ std::string format_estimate_text(const dds::EstimateTable& t) {
   if (!t.not_excited.empty())
     return out + fmt::format("  not excited by this run: {} ({} rows; --json has the numbers)\n",
                              t.not_excited, t.rows);
-  if (t.estimator != dds::kLeastSquares)
+  if (t.estimator == dds::kSimex)
+    out += "  values by SIMEX where marked (least squares corrected for the measured sensor noise)\n";
+  else if (t.estimator != dds::kLeastSquares)
     out += fmt::format("  values by {} (least squares is biased on this run: see the bias test below)\n", t.estimator);
   out += fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {}\n", "parameter", "unit", "value",
                      "std", "rel.std%", "status");

@@ -12,6 +12,7 @@
 #include "dynid/ingest/run_processor.hpp"
 #include "dynid/report/excitation_report.hpp"
 #include "dynid/residual/iv_fit.hpp"
+#include "dynid/residual/simex.hpp"
 
 namespace dynid::server {
 
@@ -33,6 +34,17 @@ dds::EstimateTable table_of(const std::string& vehicle, const std::string& sourc
 /// An IV fit of other columns (another effect set) is not applied: `table` is left as it is.
 void apply_iv(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
               const ls::WeightedEstimate& estimate, const residual::IvFit& iv, std::uint64_t through);
+
+/// The SIMEX correction on `table` (made by table_of, apply_iv applied first): where the table is
+/// still least squares', each identified parameter whose SIMEX value has a smaller estimated
+/// mean squared error than least squares' (SimexFit::improves: the correction exceeds its own
+/// Monte Carlo and noise-level uncertainty) gets SIMEX's value and std, with the least-squares
+/// ones it replaces beside it; statuses are classified again, and the estimator is kSimex when
+/// any row changed. Why not where IV replaces least squares: the bias test has then seen the bias
+/// in the data, and IV removes it with no noise model (docs/ACCURACY.md). A fit of other columns
+/// is not applied.
+void apply_simex(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
+                 const ls::WeightedEstimate& estimate, const residual::SimexFit& simex);
 
 EstimateTables tables_of(const std::string& vehicle, const std::string& source,
                          const std::vector<ingest::ModelEstimate>& estimates,

@@ -36,6 +36,7 @@
 #include "dynid/ingest/run_announcement.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/residual/iv_fit.hpp"
+#include "dynid/residual/simex.hpp"
 
 namespace dynid::server {
 
@@ -65,6 +66,7 @@ struct LiveVerdict {
   std::string verdict;    ///< "adequate", "explained", "structure left"; "" when not diagnosed
   std::string statement;  ///< Diagnosis::statement()
   std::optional<residual::IvFit> iv;
+  std::optional<residual::SimexFit> simex;
 };
 
 /// The instrumental-variable fit of a model on a run, as the `iv` request and the live
@@ -72,6 +74,19 @@ struct LiveVerdict {
 residual::IvFit iv_of(const model::Model& model, const std::vector<std::string>& effects,
                       const ingest::RunAnnouncement& announcement,
                       const std::vector<ingest::PreprocessedSegment>& segments);
+
+/// The channel noise SIMEX corrects for on a run (`run` assembled, `segments` =
+/// preprocess_offline(run)): measured above the cut-off, or declared by the profile (the
+/// announcement's channel_noise). Once per run: every model's fit shares it.
+std::vector<residual::ChannelNoise> run_noise(const ingest::RecordedRun& run,
+                                              const std::vector<ingest::PreprocessedSegment>& segments);
+
+/// The SIMEX fit of a model on a run with the run's noise (run_noise), as the live judgement
+/// takes it: SimexOptions' defaults (seed 1: a stored run gives the same values every time it is
+/// fitted).
+residual::SimexFit simex_of(const model::Model& model, const std::vector<std::string>& effects,
+                            const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
+                            const std::vector<residual::ChannelNoise>& noise);
 
 /// The verdict of each of `models` (announced models, with their declared effects) on the run so
 /// far: what a server started with --live-residual publishes beside the estimates. A model that

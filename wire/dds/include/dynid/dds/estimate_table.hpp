@@ -28,16 +28,20 @@ struct ParameterEntry {
   ls::ParameterStatus status = ls::ParameterStatus::kIdentified;
   std::string relation;  ///< for kRegrouped: the base-parameter combination
   std::string reason = {};  ///< why the status (model/parameter_status.hpp); "" when identified
-  /// When the table's estimator is kInstrumentalVariables: the least-squares value and standard
-  /// deviation the row's replace (NaN for a row IV does not estimate, and under least squares).
+  /// When the table's estimator is not kLeastSquares: the least-squares value and standard
+  /// deviation the row's replace (NaN for a row the estimator does not replace, and under least
+  /// squares).
   double least_squares_value = std::numeric_limits<double>::quiet_NaN();
   double least_squares_std = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// EstimateTable::estimator: least squares (the fold's estimate, and what an older server
-/// publishes), or instrumental variables where the live bias test rejects least squares.
+/// publishes), instrumental variables where the live bias test rejects least squares, or SIMEX
+/// (least squares corrected for the measured sensor noise, residual/simex.hpp) where the test
+/// does not reject and the correction lowers the estimated error of some row.
 inline constexpr const char* kLeastSquares = "least squares";
 inline constexpr const char* kInstrumentalVariables = "instrumental variables";
+inline constexpr const char* kSimex = "SIMEX";
 
 struct GroupResidual {
   std::string group;
@@ -67,8 +71,8 @@ struct EstimateTable {
   std::string residual_verdict = {};
   std::string residual_statement = {};
   std::uint64_t residual_through = 0;
-  /// Whose values the rows are (kLeastSquares or kInstrumentalVariables: server/estimate_tables.hpp
-  /// apply_iv) and the bias test's one line (residual/iv_fit.hpp IvFit::statement(); "" when not
+  /// Whose values the rows are (kLeastSquares, kInstrumentalVariables or kSimex:
+  /// server/estimate_tables.hpp apply_iv, apply_simex) and the bias test's one line (residual/iv_fit.hpp IvFit::statement(); "" when not
   /// computed: the live judgement off, a pool, too few rows), `bias_through` the last chunk the
   /// test includes.
   std::string estimator = kLeastSquares;
