@@ -42,8 +42,10 @@ ResidualReply trace_reply(const residual::Trace& t, const std::string& title, co
     for (const residual::TraceRound& r : t.rounds)
       if (r.added) last_added = &r;
     const residual::TraceRound& last = t.rounds.back();
+    const residual::CandidateScore* found =
+        last_added != nullptr && last_added->diagnosis.accepted ? &*last_added->diagnosis.accepted : nullptr;
     return {report::residual_html({title + " (trace: " + t.stopped + ")", &last.diagnosis.screen,
-                                   last_added != nullptr ? &*last_added->added : nullptr}),
+                                   last_added != nullptr ? &*last_added->added : nullptr, found}),
             "text/html"};
   }
   return {report::format_trace_text(t), "text/plain"};

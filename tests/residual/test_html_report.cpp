@@ -84,5 +84,25 @@ TEST(HtmlReport, OpensInHeadlessChromiumWithEveryPlotDecoded) {
   EXPECT_GT(fs::file_size(shot), 20000U);
 }
 
+// An added step located by the screen is marked on the residual plots: its time and 95 % set
+// in the caption (the shaded set and the line are drawn by the same gnuplot commands).
+TEST(HtmlReport, MarksALocatedStepOnTheResidualPlots) {
+  const sim::Run run = sim::test::run(sim::test::load_scenario_text("acceleration.toml"), 72);
+  const ingest::ModelSpec spec = sim::test::model_spec("longitudinal_wheel", {});
+  const test::ProcessedRun processed = test::process(run, spec, true);
+  const auto model = model::make_model(spec.model, spec.constants);
+  const double rate = processed.announcement.sample_rate_hz;
+  const int odmf = processed.announcement.preprocessing.odmf;
+  const EffectComparison cmp = compare_effect(*model, {}, "step:mass@20s", processed.segments, rate, odmf);
+  CandidateScore located;
+  located.effect = "step:mass@20s";
+  located.located_from_s = 18.5;
+  located.located_to_s = 21.25;
+  const std::string page = report::residual_html({"a located step", nullptr, &cmp, &located});
+  EXPECT_NE(page.find("the located step at 20 s (line), its 95 % set 18.50-21.25 s (shaded)"), std::string::npos);
+  located.effect = "drift:mass";  // not a step: nothing to mark
+  EXPECT_EQ(report::residual_html({"a drift", nullptr, &cmp, &located}).find("located step"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace dynid::residual

@@ -1,9 +1,12 @@
 #include "dynid/report/residual_html.hpp"
 
 #include <cerrno>
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -127,9 +130,28 @@ const residual::ResidualSeries* series_of(const residual::ModelFit& fit, const s
   return nullptr;
 }
 
+// A located step to mark on the residual-against-time plots: its time and 95 % set.
+struct StepMark {
+  double time_s = 0.0, from_s = 0.0, to_s = 0.0;
+};
+
+std::optional<StepMark> step_mark(const residual::CandidateScore* added) {
+  const std::string prefix = "step:";
+  if (added == nullptr || added->effect.rfind(prefix, 0) != 0 || !std::isfinite(added->located_from_s) ||
+      !std::isfinite(added->located_to_s))
+    return std::nullopt;
+  const auto at = added->effect.rfind('@');
+  if (at == std::string::npos) return std::nullopt;
+  char* end = nullptr;
+  const double t = std::strtod(added->effect.c_str() + at + 1, &end);
+  if (end == added->effect.c_str() + at + 1 || !std::isfinite(t)) return std::nullopt;
+  return StepMark{t, added->located_from_s, added->located_to_s};
+}
+
 std::vector<Figure> figures_for_group(const fs::path& dir, const residual::ModelFit& before,
                                       const residual::ModelFit* after, const std::string& effect,
-                                      const residual::ResidualSeries& b, std::size_t index) {
+                                      const residual::ResidualSeries& b, std::size_t index,
+                                      const std::optional<StepMark>& mark) {
   std::vector<Figure> out;
   const residual::ResidualSeries* a = after != nullptr ? series_of(*after, b.group) : nullptr;
   const std::string tag = fmt::format("g{}", index);
@@ -139,8 +161,19 @@ std::vector<Figure> figures_for_group(const fs::path& dir, const residual::Model
     write_columns(dir / (tag + "-after.dat"), {&a->residual}, &a->time_s);
     plot += fmt::format(", '{}-after.dat' using 1:2 with lines lw 1 title 'with {}'", tag, effect);
   }
-  out.push_back({"Residual of group " + b.group + " against time",
-                 "set xlabel 'time (s)'\nset ylabel 'residual'\n" + plot + "\n", tag + "-time.png"});
+  std::string caption = "Residual of group " + b.group + " against time";
+  std::string marking, unmarking;
+  if (mark) {
+    caption += fmt::format("; the located step at {:g} s (line), its 95 % set {:.2f}-{:.2f} s (shaded)", mark->time_s,
+                           mark->from_s, mark->to_s);
+    marking = fmt::format(
+        "set object 1 rect from {:.9g}, graph 0 to {:.9g}, graph 1 behind fc rgb '#ffe0e0' fs solid noborder\n"
+        "set arrow 1 from {:.9g}, graph 0 to {:.9g}, graph 1 nohead lc rgb '#cc0000' dt 2\n",
+        mark->from_s, mark->to_s, mark->time_s, mark->time_s);
+    unmarking = "unset object 1\nunset arrow 1\n";
+  }
+  out.push_back({caption, "set xlabel 'time (s)'\nset ylabel 'residual'\n" + marking + plot + "\n" + unmarking,
+                 tag + "-time.png"});
   if (a != nullptr && a->effect_contribution.size() == a->residual.size()) {
     // The residual before the effect against what the effect explains, row by row: only rows
     // of both fits (the effect's may leave some out) at the same times.
@@ -177,7 +210,7 @@ std::string draw(const HtmlReportInput& in, const fs::path& dir, const residual:
                  const residual::ModelFit* after, const std::string& effect) {
   std::vector<Figure> figures;
   for (std::size_t g = 0; g < before.series.size(); ++g) {
-    std::vector<Figure> f = figures_for_group(dir, before, after, effect, before.series[g], g);
+    std::vector<Figure> f = figures_for_group(dir, before, after, effect, before.series[g], g, step_mark(in.added));
     figures.insert(figures.end(), f.begin(), f.end());
   }
   std::string script = "set terminal pngcairo noenhanced size 900,420 font 'sans,10'\nset grid\nset key top right\n";

@@ -2,9 +2,10 @@
 // residual_html(): the residual loop's report as one self-contained HTML page (no external file:
 // the plots are PNG data URIs), for a browser or an e-mail. Plots are drawn by gnuplot
 // (pngcairo): per equation group, the residual against time (before, and after the added
-// effect), the residual against the effect's fitted contribution (a missing effect lies on the
-// diagonal), and the amplitude spectra of the residuals. Tables: the verdict, the ranking, the
-// before/after parameters and residual figures.
+// effect; for an added step located by the screen, its time marked and its 95 % set shaded), the
+// residual against the effect's fitted contribution (a missing effect lies on the diagonal), and
+// the amplitude spectra of the residuals. Tables: the verdict, the ranking, the before/after
+// parameters and residual figures.
 //
 // The page marks itself when the browser has decoded its images: <body data-images="k/n">
 // (k of n images with a natural width), so a test in a real browser can check it.
@@ -23,6 +24,8 @@ struct HtmlReportInput {
   std::string title;                                 ///< e.g. "dynid-testcar / run-17"
   const residual::ScreenResult* screen = nullptr;    ///< the ranking, if any
   const residual::EffectComparison* comparison = nullptr;  ///< the added effect, if any
+  /// The added effect as the screen found it, if known: a located step is marked on the plots.
+  const residual::CandidateScore* added = nullptr;
   std::string gnuplot = "gnuplot";                   ///< the program (PATH is searched)
 };
 
