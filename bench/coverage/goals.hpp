@@ -23,12 +23,12 @@ std::string verdicts(const std::vector<ParameterCoverage>& rows);
 std::string iv_verdicts(const std::vector<ParameterCoverage>& rows);
 
 /// The same for what the product's table publishes (IV where the bias test rejects LS).
-std::string published_verdicts(const std::vector<ParameterCoverage>& rows);
+std::string without_simex_verdicts(const std::vector<ParameterCoverage>& rows);
 
 /// The same for the SIMEX estimate.
 std::string simex_verdicts(const std::vector<ParameterCoverage>& rows);
 
-/// The same for the proposed published estimate (IV where DWH rejects, else SIMEX where it improves).
-std::string proposed_verdicts(const std::vector<ParameterCoverage>& rows);
+/// The same for what the server publishes (IV where DWH rejects, else SIMEX where it improves).
+std::string published_verdicts(const std::vector<ParameterCoverage>& rows);
 
 }  // namespace dynid::benchcoverage

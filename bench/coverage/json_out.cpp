@@ -71,8 +71,8 @@ nlohmann::json row_json(const ParameterCoverage& r) {
             {"scatter_pct", number(r.simex.scatter_pct)},
             {"mean_monte_carlo_std_pct", number(r.simex.mean_monte_carlo_std_pct)},
             {"std", std_json(r.simex.std)}}},
-          {"published", published_json(r.published)},
-          {"proposed", published_json(r.proposed)}};
+          {"without_simex", published_json(r.without_simex)},
+          {"published", published_json(r.published)}};
 }
 
 }  // namespace

@@ -86,10 +86,10 @@ int main(int argc, char** argv) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::vector<ParameterCoverage> rows = summarize(runs);
   std::printf("\n%s\n%s\n%s\n%s\n%s\n%s\n", markdown_table(rows).c_str(), verdicts(rows).c_str(),
-              iv_markdown_table(rows).c_str(), iv_verdicts(rows).c_str(), published_markdown_table(rows).c_str(),
-              published_verdicts(rows).c_str());
+              iv_markdown_table(rows).c_str(), iv_verdicts(rows).c_str(), without_simex_markdown_table(rows).c_str(),
+              without_simex_verdicts(rows).c_str());
   std::printf("%s\n%s\n%s\n%s\n%zu runs, %d failed, %.0f s\n", simex_markdown_table(rows).c_str(),
-              simex_verdicts(rows).c_str(), proposed_markdown_table(rows).c_str(), proposed_verdicts(rows).c_str(),
+              simex_verdicts(rows).c_str(), published_markdown_table(rows).c_str(), published_verdicts(rows).c_str(),
               runs.size(), errors_of(runs), seconds);
   if (!o.json.empty() && !write_json(o.json, runs, rows, seconds)) return 1;
   return errors_of(runs) == 0 ? 0 : 1;

@@ -120,8 +120,8 @@ ParameterCoverage row_of(const std::vector<const ParameterSample*>& samples) {
   row.hac = coverage_of(errors, hac);
   row.iv = iv_of(samples);
   row.simex = simex_of(samples);
-  row.published = published_of(samples, false);
-  row.proposed = published_of(samples, true);
+  row.without_simex = published_of(samples, false);
+  row.published = published_of(samples, true);
   return row;
 }
 
@@ -197,12 +197,12 @@ std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows) {
 
 namespace dynid::benchcoverage {
 
-std::string published_markdown_table(const std::vector<ParameterCoverage>& rows) {
+std::string without_simex_markdown_table(const std::vector<ParameterCoverage>& rows) {
   return table("| model | parameter | seeds | by IV | mean error | scatter | std | within 2 std | mean error / std |", rows,
                [](const ParameterCoverage& r) {
-                 return start(r, "%d | %d | %+.3g %% | %.3g %% |", r.published.seeds, r.published.by_iv,
-                              r.published.mean_error_pct, r.published.scatter_pct) +
-                        cells(r.published.std);
+                 return start(r, "%d | %d | %+.3g %% | %.3g %% |", r.without_simex.seeds, r.without_simex.by_iv,
+                              r.without_simex.mean_error_pct, r.without_simex.scatter_pct) +
+                        cells(r.without_simex.std);
                });
 }
 
@@ -217,13 +217,13 @@ std::string simex_markdown_table(const std::vector<ParameterCoverage>& rows) {
                });
 }
 
-std::string proposed_markdown_table(const std::vector<ParameterCoverage>& rows) {
+std::string published_markdown_table(const std::vector<ParameterCoverage>& rows) {
   return table("| model | parameter | seeds | by IV | by SIMEX | mean error | scatter | std | within 2 std | mean error / "
                "std |",
                rows, [](const ParameterCoverage& r) {
-                 return start(r, "%d | %d | %d | %+.3g %% | %.3g %% |", r.proposed.seeds, r.proposed.by_iv,
-                              r.proposed.by_simex, r.proposed.mean_error_pct, r.proposed.scatter_pct) +
-                        cells(r.proposed.std);
+                 return start(r, "%d | %d | %d | %+.3g %% | %.3g %% |", r.published.seeds, r.published.by_iv,
+                              r.published.by_simex, r.published.mean_error_pct, r.published.scatter_pct) +
+                        cells(r.published.std);
                });
 }
 

@@ -40,15 +40,16 @@ struct SimexCoverage {
   StdCoverage std;    ///< sqrt(LS HAC^2 + Monte Carlo^2 + noise level^2)
 };
 
-/// What a table publishes. `published`: what the server publishes today (server/estimate_tables.hpp
-/// apply_iv): IV's value and HAC std where the model's Durbin-Wu-Hausman test rejects least
-/// squares at 1 %, else the table's. `proposed`: the same with SIMEX's value and std in place of
-/// the table's where SIMEX's estimated mean squared error is below LS's (SimexFit::improves;
+/// What a table publishes. `without_simex`: IV's value and HAC std where the model's
+/// Durbin-Wu-Hausman test rejects least squares at 1 %, else least squares' (what the server
+/// published before SIMEX). `published`: what the server publishes (server/estimate_tables.hpp,
+/// apply_iv then apply_simex): the same with SIMEX's value and std in place of least squares'
+/// where SIMEX's estimated mean squared error is below LS's (SimexFit::improves;
 /// docs/ACCURACY.md says why).
 struct PublishedCoverage {
   int seeds = 0;     ///< seeds with a finite published value and std
   int by_iv = 0;     ///< of which by IV
-  int by_simex = 0;  ///< of which by SIMEX (proposed only)
+  int by_simex = 0;  ///< of which by SIMEX (`published` only)
   double mean_error_pct = kNaN;
   double scatter_pct = kNaN;
   std::vector<double> errors_pct;
@@ -67,8 +68,8 @@ struct ParameterCoverage {
   StdCoverage hac;               ///< the HAC std
   IvCoverage iv;
   SimexCoverage simex;
+  PublishedCoverage without_simex;
   PublishedCoverage published;
-  PublishedCoverage proposed;
 };
 
 /// One row per (model, parameter), in the order the runs first give them. A seed whose value or
@@ -84,10 +85,11 @@ std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows);
 /// The SIMEX columns beside LS's and IV's mean error, as a markdown table.
 std::string simex_markdown_table(const std::vector<ParameterCoverage>& rows);
 
-/// The published estimate's columns, as a markdown table.
-std::string published_markdown_table(const std::vector<ParameterCoverage>& rows);
+/// The table without SIMEX (IV where DWH rejects, else least squares), as a markdown table.
+std::string without_simex_markdown_table(const std::vector<ParameterCoverage>& rows);
 
-/// The proposed published estimate's columns (IV where DWH rejects, else SIMEX where it improves).
-std::string proposed_markdown_table(const std::vector<ParameterCoverage>& rows);
+/// What the server publishes, as a markdown table (IV where DWH rejects, else SIMEX where it
+/// improves).
+std::string published_markdown_table(const std::vector<ParameterCoverage>& rows);
 
 }  // namespace dynid::benchcoverage
