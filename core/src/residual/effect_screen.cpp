@@ -336,8 +336,12 @@ void locate_offset(CandidateScore& c, const SignalContext& in, const std::string
                                                       in.rate, in.odmf, in.fit, false, &in.rows);
     const Eigen::VectorXd x = detail::base_solution(detail::evaluate(rows, {}, in.weights).all);
     at_value = score_offset(in, channel, unit, x, value);
-    // Not identifiable at this offset: the candidate stays as the screen scored it, unnamed.
-    if (!at_value.testable || !std::isfinite(at_value.coefficient)) return;
+    if (!at_value.testable || !std::isfinite(at_value.coefficient)) {
+      // An offset with no value cannot be added (its name needs one): not a candidate after all.
+      c.significant = false;
+      c.note = "its offset is not identifiable on this run's rows once sought";
+      return;
+    }
     value += at_value.coefficient;
   }
   rescore_with(c, in, offset_effect_name(channel, value));
@@ -382,9 +386,10 @@ DelayProfile profile_delay(const SignalContext& in, const std::string& channel, 
 // against the best, n (cost / best - 1), divided by `inflation`, stays within chi-square(1)'s
 // 3.84. `inflation` is how much the rows' correlation inflates the variance along the delay
 // (the score column's HAC variance over its textbook one at the delay found, at least 1: no row
-// counts for more than one): the robust likelihood ratio of a quasi-likelihood. Why not the score column's std alone (Gauss-Newton):
-// it ignores that the delay is found on the raw grid and that the cost is not quadratic over a
-// few samples; it said 190 +- 1 ms for a speed 200 ms late.
+// counts for more than one): the robust likelihood ratio of a quasi-likelihood. Why not the
+// score column's std alone (Gauss-Newton): it ignores that the delay is found on the raw grid
+// and that the cost is not quadratic over a few samples; it said 190 +- 1 ms for a speed 200 ms
+// late.
 struct LocatedDelay {
   Eigen::Index samples = 0;
   Eigen::Index earliest = 0, latest = 0;  ///< the interval, samples
