@@ -1,6 +1,7 @@
 #include "dynid/residual/noise_floor.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <limits>
@@ -19,6 +20,8 @@ constexpr Eigen::Index kWelchLength = 256;
 constexpr double kBandLow = 1.5;   // x cut-off
 constexpr double kBandHigh = 3.0;  // x cut-off
 constexpr int kMaxLags = 40;       // decimated rows, for the effective number of rows
+constexpr std::array<int, 3> kBlockRows = {4, 16, 64};  // the longer time scales (header, 4.)
+constexpr double kMinBlocks = 8.0;  // fewer blocks: log of a chi-square too far from normal
 
 bool filtered(const ingest::RunAnnouncement& a, const std::string& channel) {
   const auto& pass = a.preprocessing.unfiltered;
@@ -181,6 +184,24 @@ struct LagSums {
   }
 };
 
+// The sums of `r` over blocks of `block_grid` grid samples (grid / block_grid), as a series on
+// the block index: blocks span gaps and segment edges alike in the residual and in the draws.
+std::vector<std::pair<Eigen::Index, double>> block_sums(const std::vector<std::pair<Eigen::Index, double>>& r,
+                                                        Eigen::Index block_grid) {
+  std::vector<std::pair<Eigen::Index, double>> out;
+  for (const auto& [grid, value] : r) {
+    const Eigen::Index block = grid / block_grid;
+    if (out.empty() || out.back().first != block) out.emplace_back(block, 0.0);
+    out.back().second += value;
+  }
+  return out;
+}
+
+// One time scale's sums over the draws of every contributing channel, per group.
+struct ScaleSums {
+  std::vector<std::vector<LagSums>> share;  // [channel][group]
+};
+
 ingest::RecordedRun with_noise(const ingest::RecordedRun& run, Eigen::Index column, double sigma,
                                std::mt19937_64& rng) {
   ingest::RecordedRun noisy = run;
@@ -193,6 +214,109 @@ Eigen::Index column_of(const ingest::RunAnnouncement& a, const std::string& chan
   for (std::size_t j = 0; j < a.channels.size(); ++j)
     if (a.channels[j].name == channel) return static_cast<Eigen::Index>(j);
   return -1;
+}
+
+// The floor's share sums of one group pooled over the channels (independent sensors: the mean
+// squares and lagged products add), with the variance of the pooled mean square that the
+// channels' measured sigmas carry.
+struct PooledFloor {
+  LagSums total;
+  double variance = 0.0;
+};
+
+PooledFloor pool(const std::vector<std::vector<LagSums>>& shares, std::size_t g,
+                 const std::vector<double>& share_relative_variance) {
+  PooledFloor out;
+  for (std::size_t c = 0; c < shares.size(); ++c) {
+    const LagSums& share = shares[c][g];
+    if (share.rows == 0) continue;
+    const double ms = share.square / static_cast<double>(share.rows);
+    out.variance += ms * ms * share_relative_variance[c];
+    out.total.square += ms;
+    for (std::size_t k = 0; k < out.total.lagged.size(); ++k)
+      out.total.lagged[k] += share.lagged[k] / static_cast<double>(share.rows);
+    out.total.rows = std::max(out.total.rows, share.rows);
+  }
+  return out;
+}
+
+// log(residual mean square / floor mean square) under "the model lacks nothing": the residual's
+// mean square is chi2(n_eff) / n_eff (variance 2 / n_eff), the floor's has the relative variance
+// of its sigmas and of its draws (2 / (draws n_eff)). `n` terms in the residual's mean square.
+struct LogRatio {
+  double ratio = 0.0;
+  double effective = 0.0;
+  double floor_relative_std = 0.0;
+  double std = 0.0;
+};
+
+LogRatio log_ratio(const PooledFloor& floor, double residual_mean_square, double n, int draws) {
+  LogRatio out;
+  const double ms = floor.total.square;
+  out.ratio = residual_mean_square / ms;
+  out.effective = std::max(1.0, floor.total.effective_rows(n));
+  out.floor_relative_std = std::sqrt(floor.variance / (ms * ms) + 2.0 / (draws * out.effective));
+  out.std = std::sqrt(2.0 / out.effective + out.floor_relative_std * out.floor_relative_std);
+  return out;
+}
+
+double mean_square(const std::vector<std::pair<Eigen::Index, double>>& r) {
+  double ss = 0.0;
+  for (const auto& [grid, value] : r) ss += value * value;
+  return r.empty() ? 0.0 : ss / static_cast<double>(r.size());
+}
+
+// One group's floor test at every time scale (header, 3. and 4.); `tested`: the groups with rows.
+GroupFloor group_floor(const std::string& group, const std::vector<std::pair<Eigen::Index, double>>& residual,
+                       const std::vector<std::vector<LagSums>>& shares, const std::vector<ScaleSums>& scale_shares,
+                       std::size_t g, const std::vector<double>& share_relative_variance, int odmf,
+                       double rate, const NoiseFloorOptions& options, double tested) {
+  GroupFloor f;
+  f.group = group;
+  f.rows = residual.size();
+  const auto n = static_cast<double>(f.rows);
+  const double ms = mean_square(residual);
+  f.residual_rms = std::sqrt(ms);
+  const PooledFloor floor = pool(shares, g, share_relative_variance);
+  if (f.rows == 0 || floor.total.square <= 0.0) {  // no noise reaches the rows: only an exact fit is at the floor
+    f.at_floor = f.residual_rms <= std::numeric_limits<double>::epsilon() * (1.0 + std::sqrt(ms * n));
+    return f;
+  }
+  f.floor_rms = std::sqrt(floor.total.square);
+  const LogRatio rows = log_ratio(floor, ms, n, options.draws);
+  f.ratio = rows.ratio;
+  f.effective_rows = rows.effective;
+  f.floor_relative_std = rows.floor_relative_std;
+  f.log_ratio_std = rows.std;
+  std::vector<ScaleFloor> scales;
+  std::vector<double> scale_log_std;
+  for (std::size_t s = 0; s < kBlockRows.size(); ++s) {
+    const auto blocks = block_sums(residual, static_cast<Eigen::Index>(kBlockRows[s]) * odmf);
+    const auto count = static_cast<double>(blocks.size());
+    const PooledFloor block_floor = pool(scale_shares[s].share, g, share_relative_variance);
+    if (count < kMinBlocks || block_floor.total.square <= 0.0) continue;
+    const LogRatio test = log_ratio(block_floor, mean_square(blocks), count, options.draws);
+    ScaleFloor scale;
+    scale.block_rows = kBlockRows[s];
+    scale.block_seconds = kBlockRows[s] * odmf / rate;
+    scale.ratio = test.ratio;
+    scale.effective_blocks = test.effective;
+    scale.log_ratio_std = test.std;
+    scales.push_back(scale);
+  }
+  // The rows' test decides (at error_rate over the groups, as before the scales); the scales
+  // are evidence beside it, each family of them at the same level (header, 4.).
+  const double z = boost::math::quantile(boost::math::normal(), 1.0 - options.error_rate / tested);
+  f.upper_ratio = std::exp(z * f.log_ratio_std);
+  f.at_floor = f.ratio <= f.upper_ratio;
+  const double z_scales = boost::math::quantile(
+      boost::math::normal(), 1.0 - options.error_rate / (tested * static_cast<double>(std::max<std::size_t>(scales.size(), 1))));
+  for (ScaleFloor& scale : scales) {
+    scale.upper_ratio = std::exp(z_scales * scale.log_ratio_std);
+    scale.at_floor = scale.ratio <= scale.upper_ratio;
+  }
+  f.scales = std::move(scales);
+  return f;
 }
 
 }  // namespace
@@ -236,6 +360,13 @@ std::vector<ChannelNoise> measure_channel_noise(const ingest::RecordedRun& run,
   return out;
 }
 
+const ScaleFloor* GroupFloor::worst_scale() const {
+  const ScaleFloor* worst = nullptr;
+  for (const ScaleFloor& s : scales)
+    if (!s.at_floor && (worst == nullptr || s.ratio / s.upper_ratio > worst->ratio / worst->upper_ratio)) worst = &s;
+  return worst;
+}
+
 bool NoiseFloor::adequate() const {
   return std::all_of(groups.begin(), groups.end(), [](const GroupFloor& g) { return g.rows == 0 || g.at_floor; });
 }
@@ -263,6 +394,7 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
   // uncertainty (its sigma's, measured) is carried on its own. A channel the model does not
   // read leaves the residual exactly unchanged at the first draw and gets no more.
   std::vector<std::vector<LagSums>> shares;  // [channel][group]
+  std::vector<ScaleSums> scale_shares(kBlockRows.size());
   std::vector<double> share_relative_variance;
   std::vector<std::string> contributing;
   std::mt19937_64 rng(options.seed);
@@ -270,15 +402,25 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
     const Eigen::Index column = column_of(run.announcement, c.channel);
     if (column < 0 || !(c.sigma > 0.0)) continue;
     std::vector<LagSums> sums(r0.size());
+    std::vector<std::vector<LagSums>> blocks(kBlockRows.size(), std::vector<LagSums>(r0.size()));
     for (int d = 0; d < options.draws; ++d) {
       const auto noisy = ingest::preprocess_channel_again(with_noise(run, column, c.sigma, rng), segments, column);
-      const detail::GridResiduals r1 =
-          detail::residuals_at(detail::fold_rows(model, effects, noisy, rate, odmf, fit_options, true, &rows), x);
-      for (std::size_t g = 0; g < sums.size(); ++g) sums[g].add(difference(r1[g], r0[g]), odmf);
+      // Refitted: the draw's own least squares, so that the attenuation its noise causes in the
+      // parameters of a noisy regressor (errors in variables, slow like the signals) is in the
+      // share, as the run's own noise put it into the run's residual (header, 2.).
+      const detail::FoldedRows folded = detail::fold_rows(model, effects, noisy, rate, odmf, fit_options, true, &rows);
+      const detail::GridResiduals r1 = detail::residuals_at(folded, detail::evaluate(folded, {}, {}).x);
+      for (std::size_t g = 0; g < sums.size(); ++g) {
+        const auto share = difference(r1[g], r0[g]);
+        sums[g].add(share, odmf);
+        for (std::size_t s = 0; s < kBlockRows.size(); ++s)
+          blocks[s][g].add(block_sums(share, static_cast<Eigen::Index>(kBlockRows[s]) * odmf), 1);
+      }
       if (d == 0 && std::all_of(sums.begin(), sums.end(), [](const LagSums& l) { return l.square == 0.0; })) break;
     }
     if (std::all_of(sums.begin(), sums.end(), [](const LagSums& l) { return l.square == 0.0; })) continue;
     shares.push_back(std::move(sums));
+    for (std::size_t s = 0; s < kBlockRows.size(); ++s) scale_shares[s].share.push_back(std::move(blocks[s]));
     contributing.push_back(c.channel);
     share_relative_variance.push_back(c.level_relative_variance);
   }
@@ -287,46 +429,9 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
   out.contributing = contributing;
   out.draws = options.draws;
   const auto tested = static_cast<double>(std::count_if(r0.begin(), r0.end(), [](const auto& r) { return !r.empty(); }));
-  for (std::size_t g = 0; g < r0.size(); ++g) {
-    GroupFloor f;
-    f.group = base.groups[g];
-    f.rows = r0[g].size();
-    LagSums total;
-    double floor_variance = 0.0;  // of the floor's mean square, from the shares' sigmas
-    for (std::size_t c = 0; c < shares.size(); ++c) {
-      const LagSums& share = shares[c][g];
-      if (share.rows == 0) continue;
-      const double ms = share.square / static_cast<double>(share.rows);
-      floor_variance += ms * ms * share_relative_variance[c];
-      total.square += ms;
-      for (std::size_t k = 0; k < total.lagged.size(); ++k)
-        total.lagged[k] += share.lagged[k] / static_cast<double>(share.rows);
-      total.rows = std::max(total.rows, share.rows);
-    }
-    double ss = 0.0;
-    for (const auto& [grid, r] : r0[g]) ss += r * r;
-    const auto n = static_cast<double>(f.rows);
-    f.residual_rms = f.rows > 0 ? std::sqrt(ss / n) : 0.0;
-    if (f.rows == 0 || total.square <= 0.0) {  // no noise reaches the rows: only an exact fit is at the floor
-      f.at_floor = f.residual_rms <= std::numeric_limits<double>::epsilon() * (1.0 + std::sqrt(ss));
-      out.groups.push_back(f);
-      continue;
-    }
-    f.floor_rms = std::sqrt(total.square);
-    f.ratio = (f.residual_rms * f.residual_rms) / total.square;
-    f.effective_rows = std::max(1.0, total.effective_rows(n));
-    // log(ratio) under "the model lacks nothing": the residual's mean square is chi2(n_eff) /
-    // n_eff (variance 2 / n_eff), the floor's has the relative variance of its sigmas and of its
-    // draws (2 / (draws n_eff)).
-    f.floor_relative_std = std::sqrt(floor_variance / (total.square * total.square) +
-                                     2.0 / (options.draws * f.effective_rows));
-    const double sd = std::sqrt(2.0 / f.effective_rows + f.floor_relative_std * f.floor_relative_std);
-    f.log_ratio_std = sd;
-    const double z = boost::math::quantile(boost::math::normal(), 1.0 - options.error_rate / tested);
-    f.upper_ratio = std::exp(z * sd);
-    f.at_floor = f.ratio <= f.upper_ratio;
-    out.groups.push_back(f);
-  }
+  for (std::size_t g = 0; g < r0.size(); ++g)
+    out.groups.push_back(group_floor(base.groups[g], r0[g], shares, scale_shares, g, share_relative_variance,
+                                     odmf, rate, options, tested));
   return out;
 }
 

@@ -93,6 +93,16 @@ std::string format_comparison_text(const residual::EffectComparison& c) {
                            100.0 * c.in_sample_drop(), 100.0 * c.held_out_drop());
 }
 
+// The block-sum tests of a group (noise_floor.hpp, 4.), one line.
+std::string scales_text(const residual::GroupFloor& g) {
+  if (g.scales.empty()) return {};
+  std::string out = "  over blocks of";
+  for (const residual::ScaleFloor& s : g.scales)
+    out += fmt::format("{} {:.2g} s: ratio {:.3g} (up to {:.3g}{})", &s == &g.scales.front() ? "" : ";", s.block_seconds,
+                       s.ratio, s.upper_ratio, s.at_floor ? "" : ", ABOVE");
+  return out + "\n";
+}
+
 std::string format_diagnosis_text(const residual::Diagnosis& d, std::size_t top) {
   std::string out;
   for (const residual::GroupFloor& g : d.floor.groups)
@@ -100,7 +110,8 @@ std::string format_diagnosis_text(const residual::Diagnosis& d, std::size_t top)
       out += fmt::format("group {}: residual RMS {} against a noise floor of {} (ratio of squares {:.3g}; at the "
                          "floor up to {:.3g}, {:.0f} effective rows)\n",
                          g.group, number(g.residual_rms), number(g.floor_rms), g.ratio, g.upper_ratio,
-                         g.effective_rows);
+                         g.effective_rows) +
+             scales_text(g);
   std::string noise;
   for (const residual::ChannelNoise& c : d.floor.channels)
     if (std::find(d.floor.contributing.begin(), d.floor.contributing.end(), c.channel) != d.floor.contributing.end())
@@ -177,6 +188,18 @@ json candidate_json(const residual::CandidateScore& c) {
           {"detectable", finite(c.detectable)}};
 }
 
+json scales_json(const residual::GroupFloor& g) {
+  json out = json::array();
+  for (const residual::ScaleFloor& s : g.scales)
+    out.push_back({{"block_rows", s.block_rows},
+                   {"block_seconds", finite(s.block_seconds)},
+                   {"ratio", finite(s.ratio)},
+                   {"upper_ratio", finite(s.upper_ratio)},
+                   {"effective_blocks", finite(s.effective_blocks)},
+                   {"at_floor", s.at_floor}});
+  return out;
+}
+
 json diagnosis_object(const residual::Diagnosis& d) {
   json groups = json::array();
   for (const residual::GroupFloor& g : d.floor.groups)
@@ -187,6 +210,7 @@ json diagnosis_object(const residual::Diagnosis& d) {
                       {"ratio", finite(g.ratio)},
                       {"upper_ratio", finite(g.upper_ratio)},
                       {"effective_rows", finite(g.effective_rows)},
+                      {"scales", scales_json(g)},
                       {"at_floor", g.at_floor}});
   json noise = json::array();
   for (const residual::ChannelNoise& c : d.floor.channels)
