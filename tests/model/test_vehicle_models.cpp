@@ -118,6 +118,33 @@ TEST(Longitudinal, WheelTorqueRecoversOnFlatRoad) {
                    {{"mass", kMass}, {"SCx", kSCx}, {"rolling_resistance", kRolling}});
 }
 
+// The brake force smeared by the low-pass into the rows just before and after a braking stretch
+// (their own pressure below the threshold): with brake_margin the rows within that long of a
+// braking sample are left out too, for both sources, and reach() says how far a row reads.
+TEST(Longitudinal, TheBrakeMarginLeavesOutTheRowsAroundBraking) {
+  LongitudinalRun run = longitudinal_run(0.0);
+  const Eigen::Index n = run.set.samples();
+  Eigen::VectorXd torque = run.force * kRadius;
+  torque.segment(995, 5).array() += 900.0;  // the brake's force in the 5 rows before it (0.1 s)
+  torque.segment(1200, 5).array() += 900.0;  // and after it
+  run.set.add("wheel_torque", "N m", torque);
+  const model::Constants constants{{"wheel_radius", kRadius}, {"air_density", kRho}};
+  const Identified plain = identify(*model::make_model("longitudinal_wheel", constants), run.set);
+  EXPECT_EQ(plain.rows, static_cast<std::size_t>(n - 200));
+  EXPECT_GT(relative_error(plain.value("SCx"), kSCx), 1e-4);
+  model::Constants with_margin = constants;
+  with_margin["brake_margin"] = 0.1;  // 5 samples each side
+  const auto m = model::make_model("longitudinal_wheel", with_margin);
+  const Identified margin = identify(*m, run.set);
+  EXPECT_EQ(margin.rows, static_cast<std::size_t>(n - 200 - 10));
+  expect_recovered(margin, {{"mass", kMass}, {"SCx", kSCx}, {"rolling_resistance", kRolling}});
+  EXPECT_GE(m->reach(0.02).back, 5);
+  EXPECT_GE(m->reach(0.02).ahead, 5);
+  model::Constants negative = constants;
+  negative["brake_margin"] = -0.1;
+  EXPECT_THROW(model::make_model("longitudinal_wheel", negative), InputError);
+}
+
 // A wheel-torque meter reading T0 at zero torque: the tare's zero, given as the constant
 // wheel_torque_zero, gives the exact recovery back.
 TEST(Longitudinal, WheelTorqueZeroFromTheTareIsSubtracted) {

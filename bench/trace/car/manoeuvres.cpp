@@ -235,8 +235,14 @@ class Driveline {
         };
         const std::array<double, 2> y{v_, x_};
         const double a0 = f(t, y)[0];
-        // The idle controller takes the engine back to idle, easing in over 0.3 s.
-        const double dwe = (car_.idle_speed - we_) / 0.6 * smoothstep((t - open_since_) / 0.3);
+        // The idle controller takes the engine back to idle, easing in over 0.3 s. Integrated by
+        // RK4 like every other state: the torque J_e dwe recorded at t is then the derivative of
+        // the engine speed recorded at t (forward Euler made it the slope to t + dt: half a step
+        // late, 0.06 N m against the clutch model's rows).
+        auto idle = [&](double tt, const std::array<double, 1>& w) {
+          return std::array<double, 1>{(car_.idle_speed - w[0]) / 0.6 * smoothstep((tt - open_since_) / 0.3)};
+        };
+        const double dwe = idle(t, {we_})[0];
         clamp_ = std::max(0.0, clamp_ - kClampReleaseRate * kDt);
         s.clamp_load = clamp_;
         s.engine_speed = we_;
@@ -250,7 +256,7 @@ class Driveline {
         v_ = std::max(y1[0], 0.0);
         if (brake_pa > 0.0 && v_ < 0.02) v_ = 0.0;  // held by the brake
         x_ = y1[1];
-        we_ += dwe * kDt;
+        we_ = rk4(idle, t, std::array<double, 1>{we_})[0];
         if (v_ == 0.0 && !stopped_) {
           stopped_ = true;
           stop_time_ = t;
@@ -260,10 +266,14 @@ class Driveline {
       case Mode::kLaunch: {
         const double G = car_.gear_ratio(1);
         const double tau = t - launch_start_;
-        const double clutch_torque = 230.0 * smoothstep(tau / 0.6);
+        auto clutch_torque_at = [&](double tt) { return 230.0 * smoothstep((tt - launch_start_) / 0.6); };
+        const double clutch_torque = clutch_torque_at(t);
+        // The clutch torque at each RK4 stage's own time: held over the step, the car's speed
+        // would follow the torque half a step late, and the engine's recorded torque (with a0 at
+        // t) would not be the one that moves the recorded speeds (0.06 N m on the launch rows).
         auto f = [&](double tt, const std::array<double, 3>& y) {
           const double v = std::max(y[0], 0.0);
-          const double drive = eta * G * clutch_torque / r;
+          const double drive = eta * G * clutch_torque_at(tt) / r;
           const double res = v > 0.0 || drive > car_.rolling_resistance ? load_(tt, v, y[1], mass_, drag) : drive;
           return std::array<double, 3>{(drive - res) / mass_, v, 0.0};
         };

@@ -41,8 +41,21 @@ RowReach ClutchSlipModel::reach(double sample_period) const {
 std::vector<bool> ClutchSlipModel::near_stick(const ChannelSet& set) const {
   const Eigen::VectorXd& we = set["engine_speed"];
   const Eigen::VectorXd& wi = set["gearbox_input_speed"];
-  return detail::within_margin_of(set.samples(), margin_samples(set.sample_period()),
-                                  [&](Eigen::Index k) { return std::abs(we(k) - wi(k)) < min_slip_; });
+  const Eigen::Index margin = margin_samples(set.sample_period());
+  std::vector<bool> out = detail::within_margin_of(
+      set.samples(), margin, [&](Eigen::Index k) { return std::abs(we(k) - wi(k)) < min_slip_; });
+  if (open_clamp_load_ <= 0.0) return out;
+  // The other state change: a row counted open (Gamma_n = 0) within the margin of a sample
+  // that is not (the clutch closes or opens there).
+  const Eigen::VectorXd& load = set["clutch_clamp_load"];
+  const auto gamma = clamp_load();
+  const std::vector<bool> near_closed =
+      detail::within_margin_of(set.samples(), margin, [&](Eigen::Index k) { return gamma(load(k)) > 0.0; });
+  for (Eigen::Index k = 0; k < set.samples(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    if (near_closed[i] && gamma(load(k)) == 0.0) out[i] = true;
+  }
+  return out;
 }
 
 std::function<double(double)> ClutchSlipModel::clamp_load() const {

@@ -29,6 +29,8 @@ LongitudinalModel::LongitudinalModel(const Constants& constants, Source source) 
   slip_margin_ = c.optional("clutch_slip_margin").value_or(0.0);
   // A negative margin is an error: positive() throws naming the constant.
   if (slip_margin_ < 0.0) slip_margin_ = c.positive("clutch_slip_margin", "s, >= 0");
+  brake_margin_ = c.optional("brake_margin").value_or(0.0);
+  if (brake_margin_ < 0.0) brake_margin_ = c.positive("brake_margin", "s, >= 0");
   wheel_torque_zero_ = c.optional("wheel_torque_zero").value_or(0.0);
 }
 
@@ -154,6 +156,9 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
 
 RowReach LongitudinalModel::reach(double sample_period) const {
   RowReach r = Model::reach(sample_period);
+  const Eigen::Index brake = detail::margin_samples(brake_margin_, sample_period);
+  r.back = std::max(r.back, brake);
+  r.ahead = std::max(r.ahead, brake);
   if (source_ != Source::kEngineTorque) return r;
   const Eigen::Index margin = detail::margin_samples(slip_margin_, sample_period);
   r.back = std::max(r.back, margin);
@@ -172,11 +177,15 @@ RowModel::RowFn LongitudinalModel::bind(const ChannelSet& set,
       slip_check ? detail::within_margin_of(set.samples(), detail::margin_samples(slip_margin_, set.sample_period()),
                                             [&](Eigen::Index k) { return std::abs((*engine)(k) - (*input)(k)) > slip_tolerance_; })
                  : std::vector<bool>{};
-  auto braking = detail::braking(set, brake_threshold_, enabled(effects, effect::kBrakeDrag));
+  // Braking rows, and those within brake_margin of one (the low-pass spreads the brake force's
+  // step over its impulse response, into rows whose own filtered pressure is below the threshold).
+  const std::vector<bool> braking =
+      detail::within_margin_of(set.samples(), detail::margin_samples(brake_margin_, set.sample_period()),
+                               detail::braking(set, brake_threshold_, enabled(effects, effect::kBrakeDrag)));
   const double half_rho = 0.5 * air_density_;
   return [=, this, &vx, &dvx, drive = drive(set)](Eigen::Index k, std::size_t, double* w,
                                                    double& y) {
-    if (std::abs(vx(k)) < min_speed_ || braking(k)) return false;
+    if (std::abs(vx(k)) < min_speed_ || braking[static_cast<std::size_t>(k)]) return false;
     if (slip_check && slipping[static_cast<std::size_t>(k)]) return false;
     w[0] = dvx(k);
     w[1] = half_rho * detail::signed_square(vx(k));

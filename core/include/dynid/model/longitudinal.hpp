@@ -26,7 +26,12 @@
 // (2e4 Pa), clutch_slip_tolerance (1 rad/s), clutch_slip_margin (s, 0: the rows within that
 // long of a slipping sample are left out too, because the low-pass spreads a shift's transient
 // over its impulse response; clutch_slip.hpp's stick_margin is the same for the clutch model),
-// wheel_torque_zero (N m, 0: wheel source).
+// wheel_torque_zero (N m, 0: wheel source), brake_margin (s, 0: the rows within that long of a
+// braking sample are left out too, for the same reason as clutch_slip_margin: the low-pass
+// spreads the brake force's step into the rows before and after it, whose own filtered pressure
+// is below the threshold; on the bench car's noise-free acceleration run one such row, 40 ms
+// before the brakes, 19 N of brake force in it, took SCx -1.4 %; choose 2 / cut-off like the
+// other margins).
 //
 // wheel_torque_zero: what the wheel-torque meter reads at zero torque, from the run's tare
 // (ingest/zero_calibration.hpp: standing in neutral or with the clutch open, the driveshafts
@@ -79,6 +84,7 @@ class LongitudinalModel final : public RowModel {
   double brake_threshold_;
   double slip_tolerance_;
   double slip_margin_ = 0.0;  // s
+  double brake_margin_ = 0.0;  // s
   double wheel_torque_zero_ = 0.0;  // N m
 };
 
