@@ -264,7 +264,9 @@ TEST(RunProcessor, RowsThatReadFarAroundTheirSampleDoNotDependOnTheChunking) {
   const TestRun run = test::make_clutch_run();
   const RunProcessor one = processed(run, {run.samples.rows()});
   ASSERT_NE(one.groups(0), nullptr);
-  EXPECT_GT(one.groups(0)->group(0).row_count(), 300u);
+  // Enough rows that the comparisons below are not of an empty fit (277: the open rows near
+  // the clutch closing are left out too, clutch_slip.hpp).
+  EXPECT_GT(one.groups(0)->group(0).row_count(), 250u);
   for (const auto& [largest, seed] : {std::pair{Eigen::Index{1}, 1u},
                                       {Eigen::Index{13}, 2u},
                                       {Eigen::Index{90}, 3u},
