@@ -31,7 +31,11 @@ namespace {
 
 ResidualReply diagnosis_reply(const residual::Diagnosis& d, const std::string& title, const std::string& format) {
   if (format == "json") return {report::diagnosis_json(d), "application/json"};
-  if (format == "html") return {report::residual_html({title, &d.screen, nullptr}), "text/html"};
+  if (format == "html") {
+    report::HtmlReportInput input{title, &d.screen, nullptr};
+    input.diagnosis = &d;
+    return {report::residual_html(input), "text/html"};
+  }
   return {report::format_diagnosis_text(d), "text/plain"};
 }
 
@@ -44,9 +48,10 @@ ResidualReply trace_reply(const residual::Trace& t, const std::string& title, co
     const residual::TraceRound& last = t.rounds.back();
     const residual::CandidateScore* found =
         last_added != nullptr && last_added->diagnosis.accepted ? &*last_added->diagnosis.accepted : nullptr;
-    return {report::residual_html({title + " (trace: " + t.stopped + ")", &last.diagnosis.screen,
-                                   last_added != nullptr ? &*last_added->added : nullptr, found}),
-            "text/html"};
+    report::HtmlReportInput input{title + " (trace: " + t.stopped + ")", &last.diagnosis.screen,
+                                  last_added != nullptr ? &*last_added->added : nullptr, found};
+    input.diagnosis = &last.diagnosis;
+    return {report::residual_html(input), "text/html"};
   }
   return {report::format_trace_text(t), "text/plain"};
 }

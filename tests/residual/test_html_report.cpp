@@ -18,6 +18,7 @@
 
 #include "dynid/model/registry.hpp"
 #include "dynid/report/residual_html.hpp"
+#include "dynid/residual/diagnosis.hpp"
 #include "residual_test_support.hpp"
 #include "sim_product_path.hpp"
 #include "sim_test_support.hpp"
@@ -62,14 +63,22 @@ TEST(HtmlReport, OpensInHeadlessChromiumWithEveryPlotDecoded) {
   const fs::path dir = fs::temp_directory_path() / ("dynid-html-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path page = dir / "report.html";
-  std::ofstream(page) << report::residual_html({"simulated acceleration run with a road grade", &screen, &cmp});
+  const Diagnosis diagnosis = diagnose(*model, {}, processed.recorded);
+  report::HtmlReportInput input{"simulated acceleration run with a road grade", &screen, &cmp};
+  input.diagnosis = &diagnosis;
+  const std::string html = report::residual_html(input);
+  // The correlation plot with its bounds and the floor at every time scale (with the diagnosis).
+  EXPECT_NE(html.find("Cross-correlation of the residual of group longitudinal"), std::string::npos);
+  EXPECT_NE(html.find("over its noise floor at every time scale"), std::string::npos);
+  EXPECT_NE(html.find("<h2>Diagnosis</h2>"), std::string::npos);
+  std::ofstream(page) << html;
   const std::string flags = " --headless --no-sandbox --disable-gpu --hide-scrollbars --virtual-time-budget=5000 ";
   const std::string dom =
       run_command(browser + flags + "--dump-dom 'file://" + page.string() + "' 2>/dev/null");
   const fs::path shot = DYNID_REPORT_SCREENSHOT;
   std::error_code ignored;
   fs::remove(shot, ignored);
-  (void)run_command(browser + flags + "--window-size=1100,2600 --screenshot='" + shot.string() + "' 'file://" +
+  (void)run_command(browser + flags + "--window-size=1100,3700 --screenshot='" + shot.string() + "' 'file://" +
                     page.string() + "' >/dev/null 2>&1");
   fs::remove_all(dir, ignored);
 
@@ -79,7 +88,8 @@ TEST(HtmlReport, OpensInHeadlessChromiumWithEveryPlotDecoded) {
   std::printf("Chromium decoded %s of %s images; screenshot %s\n", m[1].str().c_str(), m[2].str().c_str(),
               shot.c_str());
   EXPECT_EQ(m[1].str(), m[2].str());
-  EXPECT_GE(std::stoi(m[2].str()), 3);  // residual against time, against the effect, spectrum
+  // Residual against time, against the effect, spectrum, correlations, the floor's scales.
+  EXPECT_GE(std::stoi(m[2].str()), 5);
   ASSERT_TRUE(fs::exists(shot));
   EXPECT_GT(fs::file_size(shot), 20000U);
 }

@@ -106,8 +106,17 @@ std::vector<std::string> signature_channels(const SignatureInputs& in) {
   return out;
 }
 
+constexpr std::size_t kPlottedCurves = 4;  // per group, in Signature::curves
+
+// The group's curves, strongest (peak |c| / bound) first, kPlottedCurves at most.
+void keep_strongest(std::vector<CorrelationCurve>& group_curves, std::vector<CorrelationCurve>& out) {
+  std::sort(group_curves.begin(), group_curves.end(), [](const auto& a, const auto& b) { return a.peak > b.peak; });
+  if (group_curves.size() > kPlottedCurves) group_curves.resize(kPlottedCurves);
+  out.insert(out.end(), group_curves.begin(), group_curves.end());
+}
+
 void add_correlations(const SignatureInputs& in, const ResidualSeries& s, double error_rate, double max_lag_s,
-                      std::vector<CorrelationFinding>& found) {
+                      std::vector<CorrelationFinding>& found, std::vector<CorrelationCurve>& curves) {
   std::vector<Eigen::Index> grid;
   for (double t : s.time_s) grid.push_back(static_cast<Eigen::Index>(std::llround(t * in.rate)));
   const ChannelAtRows at(in.run, grid);
@@ -118,8 +127,9 @@ void add_correlations(const SignatureInputs& in, const ResidualSeries& s, double
   const double tests = static_cast<double>(channels.size() * static_cast<std::size_t>(2 * lags + 1) + 1) *
                        static_cast<double>(in.fit.groups.size());
   const double z = boost::math::quantile(boost::math::normal(), 1.0 - error_rate / (2.0 * tests));
+  std::vector<CorrelationCurve> group_curves;
   auto test = [&](const std::string& name, const std::vector<double>& rho_u, Eigen::Index lag,
-                  const Eigen::VectorXd& u) {
+                  const Eigen::VectorXd& u, CorrelationCurve* curve) {
     Eigen::Index n = 0;
     const double c = correlation(r, u, n);
     double sum = 0.0;
@@ -127,19 +137,28 @@ void add_correlations(const SignatureInputs& in, const ResidualSeries& s, double
     const double bound = z * std::sqrt(std::max(1.0, 1.0 + 2.0 * sum) / static_cast<double>(std::max<Eigen::Index>(n, 1)));
     if (std::abs(c) > bound)
       found.push_back({s.group, name, static_cast<double>(lag) / in.rate, c, bound});
+    if (curve != nullptr) {
+      curve->lag_s.push_back(static_cast<double>(lag) / in.rate);
+      curve->correlation.push_back(c);
+      curve->bound.push_back(bound);
+      curve->peak = std::max(curve->peak, std::abs(c) / bound);
+    }
   };
   for (const std::string& name : channels) {
     const Eigen::VectorXd u0 = at.values(name, 0);
     if (!u0.allFinite() || (u0.array() - u0.mean()).matrix().squaredNorm() <= 0.0) continue;
     const std::vector<double> rho_u = autocorrelation(demeaned(u0), grid, in.odmf, lags);
+    CorrelationCurve curve{s.group, name, {}, {}, {}};
     for (int k = -lags; k <= lags; ++k) {
       const Eigen::Index lag = static_cast<Eigen::Index>(k) * in.odmf;
-      test(name, rho_u, lag, k == 0 ? u0 : at.values(name, lag));
+      test(name, rho_u, lag, k == 0 ? u0 : at.values(name, lag), &curve);
     }
+    group_curves.push_back(std::move(curve));
   }
+  keep_strongest(group_curves, curves);
   Eigen::VectorXd time(static_cast<Eigen::Index>(s.time_s.size()));
   for (std::size_t i = 0; i < s.time_s.size(); ++i) time(static_cast<Eigen::Index>(i)) = s.time_s[i];
-  if (time.size() > 2) test("time", autocorrelation(demeaned(time), grid, in.odmf, lags), 0, time);
+  if (time.size() > 2) test("time", autocorrelation(demeaned(time), grid, in.odmf, lags), 0, time, nullptr);
 }
 
 void locate_span(const SignatureInputs& in, const ResidualSeries& s, double floor_rms, Signature& out) {
@@ -172,7 +191,7 @@ double peak_frequency(const Spectrum& spectrum) {
 Signature signature_of(const SignatureInputs& in, const DiagnosisOptions& options) {
   Signature out;
   for (const ResidualSeries& s : in.fit.series) {
-    add_correlations(in, s, options.error_rate, options.max_lag_s, out.correlations);
+    add_correlations(in, s, options.error_rate, options.max_lag_s, out.correlations, out.curves);
     const auto g = std::find_if(in.floor.groups.begin(), in.floor.groups.end(),
                                 [&](const GroupFloor& f) { return f.group == s.group; });
     if (g != in.floor.groups.end()) locate_span(in, s, g->floor_rms, out);
@@ -191,6 +210,11 @@ Signature signature_of(const SignatureInputs& in, const DiagnosisOptions& option
   out.correlations = std::move(kept);
   if (!in.fit.series.empty()) out.peak_frequency_hz = peak_frequency(in.fit.series.front().spectrum);
   return out;
+}
+
+SignatureInputs signature_inputs(const model::Model& model, const std::vector<ingest::PreprocessedSegment>& segments,
+                                 const Diagnosis& d, double rate, int odmf, const DiagnosisOptions& options) {
+  return {model, segments, d.screen.fit, d.floor, rate, odmf, options.screen.fit.cross_validation.block_seconds};
 }
 
 std::string format(const char* pattern, double a, double b = 0.0, double c = 0.0) {
@@ -503,6 +527,7 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
     if (!(probe.accepted && probe.partial)) {
       d.verdict = Verdict::kAdequate;
       d.inseparable = inseparable_effects(model, d.screen);
+      d.signature = signature_of(signature_inputs(model, segments, d, rate, odmf, options), options);
       return d;
     }
     d.accepted = std::move(probe.accepted);
@@ -514,9 +539,7 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
   }
   d.inseparable = inseparable_effects(model, d.screen, d.accepted ? d.accepted->effect : "");
   d.verdict = d.accepted && !d.partial ? Verdict::kExplained : Verdict::kStructureLeft;
-  const SignatureInputs in{model, segments, d.screen.fit, d.floor, rate, odmf,
-                           options.screen.fit.cross_validation.block_seconds};
-  d.signature = signature_of(in, options);
+  d.signature = signature_of(signature_inputs(model, segments, d, rate, odmf, options), options);
   return d;
 }
 

@@ -1,5 +1,6 @@
 #include "dynid/report/residual_html.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -206,12 +207,63 @@ std::vector<Figure> figures_for_group(const fs::path& dir, const residual::Model
   return out;
 }
 
+// The residual's cross-correlation with the group's plotted channels against the lag, each with
+// its significance bound (dashed, both signs) in the same colour.
+std::optional<Figure> correlation_figure(const fs::path& dir, const residual::Signature& signature,
+                                         const std::string& group, std::size_t index) {
+  std::string plot;
+  int colour = 0;
+  for (const residual::CorrelationCurve& c : signature.curves) {
+    if (c.group != group || c.lag_s.empty()) continue;
+    const std::string file = fmt::format("g{}-corr{}.dat", index, ++colour);
+    std::ofstream out(dir / file);
+    for (std::size_t i = 0; i < c.lag_s.size(); ++i)
+      out << fmt::format("{:.9g} {:.9g} {:.9g}\n", c.lag_s[i], c.correlation[i], c.bound[i]);
+    plot += fmt::format("{}'{}' using 1:2 with linespoints pt 7 ps 0.4 lc {} title '{}', '' using 1:3 with lines dt 2 "
+                        "lc {} notitle, '' using 1:(-$3) with lines dt 2 lc {} notitle",
+                        plot.empty() ? "plot " : ", ", file, colour, c.channel, colour, colour);
+  }
+  if (plot.empty()) return std::nullopt;
+  return Figure{"Cross-correlation of the residual of group " + group +
+                    " with the channels nearest their bound, against the lag (> 0: the residual follows the "
+                    "channel); dashed: each one's significance bound",
+                "set xlabel 'lag (s)'\nset ylabel 'correlation'\n" + plot + "\n",
+                fmt::format("g{}-correlation.png", index)};
+}
+
+// The floor test at every time scale: residual over floor (the rows' mean square, then the
+// block sums) against the block's length, with each test's critical ratio.
+std::optional<Figure> scales_figure(const fs::path& dir, const residual::NoiseFloor& floor, const std::string& group,
+                                    std::size_t index) {
+  const auto g = std::find_if(floor.groups.begin(), floor.groups.end(),
+                              [&](const residual::GroupFloor& f) { return f.group == group; });
+  if (g == floor.groups.end() || g->scales.empty() || !(g->upper_ratio > 0.0) || !(g->ratio > 0.0)) return std::nullopt;
+  const double row_seconds = g->scales.front().block_seconds / g->scales.front().block_rows;
+  const std::string file = fmt::format("g{}-scales.dat", index);
+  std::ofstream out(dir / file);
+  out << fmt::format("{:.9g} {:.9g} {:.9g}\n", row_seconds, g->ratio, g->upper_ratio);
+  for (const residual::ScaleFloor& s : g->scales)
+    if (s.ratio > 0.0) out << fmt::format("{:.9g} {:.9g} {:.9g}\n", s.block_seconds, s.ratio, s.upper_ratio);
+  return Figure{"Residual of group " + group +
+                    " over its noise floor at every time scale (a row, then sums over blocks of rows); the "
+                    "model lacks nothing up to the critical ratio",
+                fmt::format("set xlabel 'block length (s)'\nset ylabel 'residual / floor'\nset logscale xy\n"
+                            "plot '{0}' using 1:2 with linespoints pt 7 title 'residual / floor', '{0}' using 1:3 "
+                            "with linespoints dt 2 pt 6 title 'critical ratio', 1 lc rgb '#888888' notitle\n"
+                            "unset logscale xy\n",
+                            file),
+                fmt::format("g{}-scales.png", index)};
+}
+
 std::string draw(const HtmlReportInput& in, const fs::path& dir, const residual::ModelFit& before,
                  const residual::ModelFit* after, const std::string& effect) {
   std::vector<Figure> figures;
   for (std::size_t g = 0; g < before.series.size(); ++g) {
     std::vector<Figure> f = figures_for_group(dir, before, after, effect, before.series[g], g, step_mark(in.added));
     figures.insert(figures.end(), f.begin(), f.end());
+    if (in.diagnosis == nullptr) continue;
+    if (auto c = correlation_figure(dir, in.diagnosis->signature, before.series[g].group, g)) figures.push_back(*c);
+    if (auto s = scales_figure(dir, in.diagnosis->floor, before.series[g].group, g)) figures.push_back(*s);
   }
   std::string script = "set terminal pngcairo noenhanced size 900,420 font 'sans,10'\nset grid\nset key top right\n";
   for (const Figure& f : figures) script += "set output '" + f.png + "'\n" + f.commands;
@@ -244,6 +296,9 @@ std::string residual_html(const HtmlReportInput& in) {
                                                               : nullptr;
   if (before == nullptr) throw std::invalid_argument("residual_html: neither a screen nor a comparison");
   std::string body = "<h1>dynid residual report: " + html_escape(in.title) + "</h1>\n";
+  if (in.diagnosis != nullptr)
+    body += "<h2>Diagnosis</h2>\n<p><b>" + html_escape(residual::verdict_name(in.diagnosis->verdict)) + "</b>: " +
+            html_escape(in.diagnosis->statement()) + "</p>\n";
   if (in.screen != nullptr)
     body += "<h2>What the model lacks</h2>\n<p><b>" + html_escape(in.screen->verdict()) + "</b></p>\n<pre>" +
             html_escape(format_screen_text(*in.screen)) + "</pre>\n";

@@ -61,8 +61,22 @@ struct CorrelationFinding {
   double bound = 0.0;       ///< the significance bound on |correlation| at this lag
 };
 
+/// One channel's cross-correlation with one group's residual at every lag tested, with its
+/// significance bound (for the report's plots).
+struct CorrelationCurve {
+  std::string group;
+  std::string channel;
+  std::vector<double> lag_s;
+  std::vector<double> correlation;
+  std::vector<double> bound;
+  double peak = 0.0;  ///< the largest |correlation| / bound over the lags (> 1: significant)
+};
+
 struct Signature {
   std::vector<CorrelationFinding> correlations;  ///< significant, strongest (|c| / bound) first, <= 8
+  /// Per group, the kPlottedCurves channels whose correlation comes nearest its bound (or beyond
+  /// it), strongest first: what the HTML report plots. Computed whatever the verdict.
+  std::vector<CorrelationCurve> curves;
   std::string span_group;
   double span_start_s = 0.0;  ///< the cross-validation block whose residual RMS over the floor
   double span_end_s = 0.0;    ///< is highest

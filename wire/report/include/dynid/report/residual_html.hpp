@@ -4,8 +4,11 @@
 // (pngcairo): per equation group, the residual against time (before, and after the added
 // effect; for an added step located by the screen, its time marked and its 95 % set shaded), the
 // residual against the effect's fitted contribution (a missing effect lies on the diagonal), and
-// the amplitude spectra of the residuals. Tables: the verdict, the ranking, the before/after
-// parameters and residual figures.
+// the amplitude spectra of the residuals; with a diagnosis, per group the residual's
+// cross-correlation with the channels that come nearest their significance bound, against the
+// lag, with those bounds (Signature::curves), and the floor test at every time scale (the rows'
+// mean square and the block sums over the floor's, with each critical ratio). Tables: the
+// verdict, the ranking, the before/after parameters and residual figures.
 //
 // The page marks itself when the browser has decoded its images: <body data-images="k/n">
 // (k of n images with a natural width), so a test in a real browser can check it.
@@ -15,6 +18,7 @@
 #include <optional>
 #include <string>
 
+#include "dynid/residual/diagnosis.hpp"
 #include "dynid/residual/effect_comparison.hpp"
 #include "dynid/residual/effect_screen.hpp"
 
@@ -27,6 +31,8 @@ struct HtmlReportInput {
   /// The added effect as the screen found it, if known: a located step is marked on the plots.
   const residual::CandidateScore* added = nullptr;
   std::string gnuplot = "gnuplot";                   ///< the program (PATH is searched)
+  /// The diagnosis the screen belongs to, if any: its statement, correlation and floor plots.
+  const residual::Diagnosis* diagnosis = nullptr;
 };
 
 std::string residual_html(const HtmlReportInput& input);
