@@ -337,11 +337,11 @@ OwnFloor own_floor(const CandidateScore& c, const FloorInputs& in, const NoiseFl
 // The accepted candidate explains the residual when the model it makes passes the floor test;
 // when its residual stays above that model's floor it explains a part only (Diagnosis::partial):
 // the verdict is then "structure left", with the candidate named as the part it explains. A
-// missing effect that explains the whole residual goes before one that explains a part, however
-// much more of the rows' noise-dominated mean square the latter takes: the floor test is the
-// criterion of adequacy at every time scale, the held-out error only at the rows' (bench/trace:
-// a head wind's slow residual is taken to the floor by linear_drag, -1.6 % held out, and left
-// above it by a lag of the accelerometer, -10 %). The
+// missing effect that explains the whole residual (its model passes the floor test) goes before
+// one that explains a part, however much more of the rows' noise-dominated mean square the
+// latter takes: the floor test is the criterion of adequacy, the held-out error a ranking (with
+// the block tests in the verdict, tried: a head wind's slow residual was taken to the floor by
+// linear_drag, -1.6 % held out, and left above it by a lag of the accelerometer, -10 %). The
 // floor test's level is the chance that a candidate that explains everything is called partial
 // (NoiseFloorOptions::error_rate, 0.025); measured on bench/trace, every effect no family expresses (tyre relaxation, backlash,
 // gusts) left its best candidate's model 1.3 to 4 times above its floor.

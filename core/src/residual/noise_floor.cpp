@@ -289,7 +289,6 @@ GroupFloor group_floor(const std::string& group, const std::vector<std::pair<Eig
   f.floor_relative_std = rows.floor_relative_std;
   f.log_ratio_std = rows.std;
   std::vector<ScaleFloor> scales;
-  std::vector<double> scale_log_std;
   for (std::size_t s = 0; s < kBlockRows.size(); ++s) {
     const auto blocks = block_sums(residual, static_cast<Eigen::Index>(kBlockRows[s]) * odmf);
     const auto count = static_cast<double>(blocks.size());
