@@ -2,6 +2,10 @@
 // Store: the server's durable archive (one SQLite file) of vehicles, run announcements, raw
 // chunks (the source of truth), the per-run ledger, accumulator checkpoints and estimate history.
 //
+// Backends. The rules below live here, once; a backend only reads and writes rows
+// (src/backend.hpp). The location selects it (location.hpp): a file path is an SQLite file; a
+// postgresql:// URI is refused until the PostgreSQL backend exists.
+//
 // Durability. The file is in WAL mode with synchronous=FULL on every commit: a write function
 // that returns has had its transaction appended to the write-ahead log and fsync'd. So once
 // store_chunk() returns `stored` or `duplicate`, the chunk survives a crash of the process
@@ -127,13 +131,15 @@ struct EstimateRecord {
 
 class Store {
  public:
-  /// Opens or creates the file, checks it, brings its schema up to date and resets the folded
-  /// marks to the checkpoints. StoreError/CorruptionError name the file.
-  explicit Store(const std::string& path, StoreOptions options = {});
+  /// Opens the location's backend (location.hpp), creating the file if absent, checks it,
+  /// brings its schema up to date and resets the folded marks to the checkpoints.
+  /// StoreError/CorruptionError name the location.
+  explicit Store(const std::string& location, StoreOptions options = {});
   ~Store();
   Store(Store&&) noexcept;
   Store& operator=(Store&&) noexcept;
 
+  /// The location as given.
   const std::string& path() const;
 
   /// Records a run (and its vehicle on first sight) after announcement.validate(). The same
