@@ -2,6 +2,7 @@
 #include "backend.hpp"
 #include "dynid/error.hpp"
 #include "dynid/store/location.hpp"
+#include "postgres_backend.hpp"
 #include "sqlite_backend.hpp"
 
 namespace dynid::store::detail {
@@ -10,10 +11,7 @@ std::unique_ptr<Backend> open_backend(const std::string& location, const StoreOp
   if (options.reorder_window == 0) {
     throw InputError("store " + for_messages(location) + ": reorder_window must be at least 1");
   }
-  if (is_postgres_uri(location)) {
-    throw StoreError("store " + for_messages(location) + ": this build has no PostgreSQL backend",
-                     0);
-  }
+  if (is_postgres_uri(location)) return std::make_unique<PostgresBackend>(location, options);
   return std::make_unique<SqliteBackend>(location, options);
 }
 
