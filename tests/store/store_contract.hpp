@@ -1,9 +1,9 @@
 #pragma once
 // The store's contract suite (store.hpp), written once and run against every backend: each
-// TEST_P of test_store_roundtrip/order/batch/bad_input.cpp opens its stores through
+// TEST_P of test_store_roundtrip/order/batch/bad_input/leases.cpp opens its stores through
 // StoreContract::open() at a location of the engine it is instantiated with. test_store
-// instantiates it for SQLite (contract_sqlite.cpp), test_store_postgres for PostgreSQL on a
-// server it starts itself (contract_postgres.cpp, label `cluster`).
+// instantiates it for SQLite (test_store_sqlite.cpp), test_store_postgres for PostgreSQL on a
+// server it starts itself (test_store_postgres.cpp, label `cluster`).
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -50,6 +50,7 @@ inline std::string engine_name(const ::testing::TestParamInfo<Engine>& info) {
 
 class StoreRoundTrip : public StoreContract {};
 class StoreBatch : public StoreContract {};
+class StoreLeases : public StoreContract {};
 
 /// One run, in a store whose reorder window is 8 (test_store_order.cpp).
 class StoreOrder : public StoreContract {
@@ -90,4 +91,5 @@ class StoreBadInput : public StoreContract {
   INSTANTIATE_TEST_SUITE_P(prefix, StoreRoundTrip, ::testing::Values(engine), engine_name); \
   INSTANTIATE_TEST_SUITE_P(prefix, StoreOrder, ::testing::Values(engine), engine_name);     \
   INSTANTIATE_TEST_SUITE_P(prefix, StoreBatch, ::testing::Values(engine), engine_name);     \
-  INSTANTIATE_TEST_SUITE_P(prefix, StoreBadInput, ::testing::Values(engine), engine_name)
+  INSTANTIATE_TEST_SUITE_P(prefix, StoreBadInput, ::testing::Values(engine), engine_name);  \
+  INSTANTIATE_TEST_SUITE_P(prefix, StoreLeases, ::testing::Values(engine), engine_name)

@@ -247,7 +247,7 @@ void downgrade_to_version_1(const std::string& path) {
           " stored_ns INTEGER NOT NULL, PRIMARY KEY (run_id, sequence)) WITHOUT ROWID;"
           "INSERT INTO chunks_v1 SELECT run_id, sequence, first_sample_index, rows, bytes, crc,"
           " stored_ns FROM chunks;"
-          "DROP TABLE chunks; ALTER TABLE chunks_v1 RENAME TO chunks;"
+          "DROP TABLE chunks; ALTER TABLE chunks_v1 RENAME TO chunks; DROP TABLE leases;"
           "DELETE FROM schema_version WHERE version > 1; COMMIT;");
 }
 
@@ -266,7 +266,7 @@ TEST(StoreSchema, VersionOneFileIsMigratedKeepingEveryChunkAndItsLedger) {
             1);
 
   Store store(path);
-  EXPECT_EQ(raw_int(path, "SELECT max(version) FROM schema_version"), 2);
+  EXPECT_EQ(raw_int(path, "SELECT max(version) FROM schema_version"), 3);
   EXPECT_EQ(raw_int(path, "SELECT count(*) FROM sqlite_schema WHERE name = 'chunks' AND "
                           "sql LIKE '%WITHOUT ROWID%'"),
             0);

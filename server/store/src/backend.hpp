@@ -66,6 +66,13 @@ struct ChunkColumns {
   std::int64_t crc = 0;
 };
 
+/// A lease as a write finds it: remaining_ns > 0 while it has not expired (on the clock that
+/// judges expiry: store.hpp, Leases).
+struct LeaseState {
+  Lease lease;
+  std::int64_t remaining_ns = 0;
+};
+
 struct ChunkRow {
   ChunkColumns columns;
   std::string bytes;
@@ -133,6 +140,15 @@ class Backend {
                                std::int64_t crc) = 0;
   virtual std::vector<StoredEstimate> estimates(std::int64_t vehicle_id,
                                                 const std::string& model) = 0;
+
+  // ---- leases (store.hpp, Leases; inside a transaction the Store opens) ----
+  /// Takes the lease if free or expired, renews it if holder's; returns it as it stands.
+  virtual Lease acquire_lease(const std::string& vehicle, const std::string& holder,
+                              std::int64_t ttl_ns) = 0;
+  virtual void release_lease(const std::string& vehicle, const std::string& holder) = 0;
+  virtual std::vector<Lease> leases() = 0;
+  /// The vehicle's lease, kept from changing until the transaction ends (a takeover waits).
+  virtual std::optional<LeaseState> lease_for_write(const std::string& vehicle) = 0;
 };
 
 /// The backend for a location: a postgresql:// (or postgres://) URI opens PostgreSQL, anything

@@ -60,7 +60,7 @@ StoreChunkResult Store::Impl::store_valid(const detail::RunRow& run, const inges
   const RunKey key{chunk.vehicle, chunk.run};
   const std::string label = name_of(key, chunk.sequence);
 
-  const auto transaction = s.backend->begin();  // rolls back on every early return and throw
+  const auto transaction = s.begin_write(key.vehicle);  // rolls back on every return and throw
   const detail::Ledger ledger = s.ledger(run.id);
   if (const auto stored = stored_bytes(*s.backend, run.id, chunk.sequence)) {
     if (*stored == bytes) return {ChunkStatus::duplicate, from_db(ledger.contiguous), {}};
@@ -112,7 +112,7 @@ void Store::mark_folded(const RunKey& key, std::uint64_t sequence) {
   Impl& s = *impl_;
   const std::int64_t run_id = s.run(key).id;
   const std::int64_t mark = to_db(sequence, name_of(key));
-  const auto transaction = s.backend->begin();
+  const auto transaction = s.begin_write(key.vehicle);
   const detail::Ledger ledger = s.ledger(run_id);
   if (mark > ledger.contiguous) {
     throw InputError("run " + name_of(key) + ": cannot mark #" + std::to_string(sequence) +
@@ -133,7 +133,7 @@ void Store::save_checkpoint(const RunKey& key, std::uint64_t folded, std::string
   const std::int64_t mark = to_db(folded, name_of(key));
   const std::string where =
       "checkpoint of run " + name_of(key) + " through #" + std::to_string(folded);
-  const auto transaction = s.backend->begin();
+  const auto transaction = s.begin_write(key.vehicle);
   const detail::Ledger ledger = s.ledger(run_id);
   if (mark > ledger.contiguous) throw InputError(where + ": those chunks are not all stored");
   if (const auto newest = s.backend->newest_checkpoint(run_id)) {

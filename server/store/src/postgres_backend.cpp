@@ -74,6 +74,21 @@ constexpr const char* kEstimates =
     "SELECT scope, time_ns, encoded, crc FROM estimates WHERE vehicle_id = $1 AND model = $2 "
     "ORDER BY time_ns, id";
 
+// Leases are judged on the database server's clock (dynid_now_ns(), postgres_schema.cpp), so
+// servers whose clocks differ agree.
+constexpr const char* kTakeLease =
+    "INSERT INTO leases AS l (vehicle, holder, expires_ns) VALUES ($1, $2, dynid_now_ns() + $3) "
+    "ON CONFLICT (vehicle) DO UPDATE SET holder = excluded.holder, "
+    "expires_ns = excluded.expires_ns WHERE l.holder = excluded.holder OR "
+    "l.expires_ns <= dynid_now_ns()";
+// FOR SHARE: a takeover (the upsert above) waits until the writes that checked it commit.
+constexpr const char* kLeaseForWrite =
+    "SELECT holder, expires_ns, expires_ns - dynid_now_ns() FROM leases WHERE vehicle = $1 "
+    "FOR SHARE";
+constexpr const char* kDropLease = "DELETE FROM leases WHERE vehicle = $1 AND holder = $2";
+constexpr const char* kLeases =
+    "SELECT vehicle, holder, expires_ns FROM leases ORDER BY vehicle COLLATE \"C\"";
+
 // Folds held only in memory did not survive the previous process (store.hpp, Folding).
 constexpr const char* kResetFoldedMarks =
     "UPDATE ledger SET folded_through = coalesce((SELECT max(folded_through) FROM checkpoints c "
@@ -293,6 +308,32 @@ std::vector<StoredEstimate> PostgresBackend::estimates(std::int64_t vehicle_id,
   for (int r = 0; r < rows.rows(); ++r)
     history.push_back({rows.bytes(r, 0), rows.i64(r, 1), rows.bytes(r, 2), rows.i64(r, 3)});
   return history;
+}
+
+// ---- leases ------------------------------------------------------------------------------
+
+Lease PostgresBackend::acquire_lease(const std::string& vehicle, const std::string& holder,
+                                     std::int64_t ttl_ns) {
+  connection_.run(kTakeLease, Params().text(vehicle).text(holder).i64(ttl_ns));
+  return lease_for_write(vehicle).value().lease;
+}
+
+void PostgresBackend::release_lease(const std::string& vehicle, const std::string& holder) {
+  connection_.run(kDropLease, Params().text(vehicle).text(holder));
+}
+
+std::vector<Lease> PostgresBackend::leases() {
+  const pq::Result rows = connection_.run(kLeases, Params());
+  std::vector<Lease> all;
+  for (int r = 0; r < rows.rows(); ++r)
+    all.push_back({rows.bytes(r, 0), rows.bytes(r, 1), rows.i64(r, 2)});
+  return all;
+}
+
+std::optional<LeaseState> PostgresBackend::lease_for_write(const std::string& vehicle) {
+  const pq::Result row = connection_.run(kLeaseForWrite, Params().text(vehicle));
+  if (row.rows() == 0) return std::nullopt;
+  return LeaseState{{vehicle, row.bytes(0, 0), row.i64(0, 1)}, row.i64(0, 2)};
 }
 
 }  // namespace dynid::store::detail

@@ -10,6 +10,9 @@
 //   row, and the unique key (run_id, sequence) makes a chunk stored at most once whatever else
 //   goes wrong.
 // - Reads of a replay fetch a bounded batch of chunks at a time (kReplayBatch).
+// - Leases (store.hpp) expire on the database server's clock (dynid_now_ns(), schema version
+//   2), so servers whose clocks differ agree; a fenced write reads the lease FOR SHARE, so a
+//   takeover (an upsert of the lease row) waits until that write has committed.
 // - Opening resets every run's folded mark to its checkpoint (store.hpp, Folding), as SQLite's
 //   does: right for one server per database. With several servers sharing one, this must
 //   become per vehicle, when a server takes a vehicle's lease over (issue 20: not yet).
@@ -63,6 +66,12 @@ class PostgresBackend final : public Backend {
   void insert_estimate(std::int64_t vehicle_id, const EstimateRecord& estimate,
                        std::int64_t crc) override;
   std::vector<StoredEstimate> estimates(std::int64_t vehicle_id, const std::string& model) override;
+
+  Lease acquire_lease(const std::string& vehicle, const std::string& holder,
+                      std::int64_t ttl_ns) override;
+  void release_lease(const std::string& vehicle, const std::string& holder) override;
+  std::vector<Lease> leases() override;
+  std::optional<LeaseState> lease_for_write(const std::string& vehicle) override;
 
  private:
   std::string uri_;

@@ -71,10 +71,23 @@ CREATE INDEX estimates_by_vehicle_model ON estimates (vehicle_id, model, time_ns
 INSERT INTO dynid_schema (version) VALUES (1);
 )sql";
 
+// Version 2: leases (store.hpp, Leases): which server serves a vehicle until when, on the
+// database server's clock.
+constexpr const char* kVersion2 = R"sql(
+CREATE TABLE leases (
+  vehicle    TEXT PRIMARY KEY,
+  holder     TEXT NOT NULL,
+  expires_ns BIGINT NOT NULL
+);
+CREATE FUNCTION dynid_now_ns() RETURNS BIGINT LANGUAGE sql VOLATILE
+  AS $$ SELECT (extract(epoch FROM clock_timestamp()) * 1000000000)::bigint $$;
+INSERT INTO dynid_schema (version) VALUES (2);
+)sql";
+
 // migrations[v] takes a database from version v to v + 1 (v = 0 is a database without our
 // tables). A later version appends its script and bumps kSchemaVersion; the script also
 // records its version in dynid_schema.
-constexpr std::array<const char*, kSchemaVersion> kMigrations = {kVersion1};
+constexpr std::array<const char*, kSchemaVersion> kMigrations = {kVersion1, kVersion2};
 
 // 'dyni' in ASCII, as the SQLite store's application id: the advisory lock of migrations.
 constexpr const char* kLockMigrations = "SELECT pg_advisory_xact_lock(1685682025)";

@@ -11,7 +11,7 @@
 
 namespace dynid::store::detail::postgres {
 
-inline constexpr int kSchemaVersion = 1;
+inline constexpr int kSchemaVersion = 2;
 
 void bring_up_to_date(pq::Connection& connection);
 

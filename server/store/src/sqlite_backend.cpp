@@ -266,4 +266,33 @@ std::vector<StoredEstimate> SqliteBackend::estimates(std::int64_t vehicle_id,
   return rows;
 }
 
+// ---- leases ------------------------------------------------------------------------------
+
+Lease SqliteBackend::acquire_lease(const std::string& vehicle, const std::string& holder,
+                                   std::int64_t ttl_ns) {
+  const std::int64_t now = now_ns();
+  take_lease_.start().bind(1, vehicle).bind(2, holder).bind(3, now + ttl_ns).bind(4, now).run();
+  return lease_for_write(vehicle).value().lease;
+}
+
+void SqliteBackend::release_lease(const std::string& vehicle, const std::string& holder) {
+  drop_lease_.start().bind(1, vehicle).bind(2, holder).run();
+}
+
+std::vector<Lease> SqliteBackend::leases() {
+  std::vector<Lease> all;
+  for (select_leases_.start(); select_leases_.step();) {
+    all.push_back({select_leases_.column_text(0), select_leases_.column_text(1),
+                   select_leases_.column_int(2)});
+  }
+  return all;
+}
+
+// The file's write lock, held by the transaction, already keeps the lease from changing.
+std::optional<LeaseState> SqliteBackend::lease_for_write(const std::string& vehicle) {
+  Query query(find_lease_);
+  if (!query->bind(1, vehicle).bind(2, now_ns()).step()) return std::nullopt;
+  return LeaseState{{vehicle, query->column_text(0), query->column_int(1)}, query->column_int(2)};
+}
+
 }  // namespace dynid::store::detail

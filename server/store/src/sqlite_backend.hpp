@@ -4,7 +4,9 @@
 // when the store opens and reused by every call; a write transaction is BEGIN IMMEDIATE (so
 // the run's ledger row is locked with the whole file, which one writer holds at a time);
 // commits fsync the log; a thread of its own copies the log back into the file
-// (wal_checkpointer.hpp). Opening runs the integrity check StoreOptions asks for.
+// (wal_checkpointer.hpp). Opening runs the integrity check StoreOptions asks for. Leases
+// expire on this machine's clock; the file's write lock keeps a lease from changing while a
+// write that checked it is open.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -57,6 +59,12 @@ class SqliteBackend final : public Backend {
                        std::int64_t crc) override;
   std::vector<StoredEstimate> estimates(std::int64_t vehicle_id, const std::string& model) override;
 
+  Lease acquire_lease(const std::string& vehicle, const std::string& holder,
+                      std::int64_t ttl_ns) override;
+  void release_lease(const std::string& vehicle, const std::string& holder) override;
+  std::vector<Lease> leases() override;
+  std::optional<LeaseState> lease_for_write(const std::string& vehicle) override;
+
  private:
   Database db_;
   std::string name_;
@@ -104,6 +112,17 @@ class SqliteBackend final : public Backend {
                          "SELECT r.name, r.closed_ns, l.contiguous_through, l.folded_through, "
                          "(SELECT count(*) FROM chunks c WHERE c.run_id = r.id) FROM runs r "
                          "JOIN ledger l ON l.run_id = r.id WHERE r.vehicle_id = ?1 ORDER BY r.id"};
+
+  // Leases, judged on this machine's clock (?4, ?2: now).
+  Statement take_lease_{db_,
+                        "INSERT INTO leases (vehicle, holder, expires_ns) VALUES (?1, ?2, ?3) "
+                        "ON CONFLICT (vehicle) DO UPDATE SET holder = excluded.holder, "
+                        "expires_ns = excluded.expires_ns "
+                        "WHERE leases.holder = excluded.holder OR leases.expires_ns <= ?4"};
+  Statement find_lease_{
+      db_, "SELECT holder, expires_ns, expires_ns - ?2 FROM leases WHERE vehicle = ?1"};
+  Statement drop_lease_{db_, "DELETE FROM leases WHERE vehicle = ?1 AND holder = ?2"};
+  Statement select_leases_{db_, "SELECT vehicle, holder, expires_ns FROM leases ORDER BY vehicle"};
 
   // Last: destroyed first, before the connection it hooks (wal_checkpointer.hpp).
   WalCheckpointer checkpointer_{db_};

@@ -54,6 +54,28 @@ detail::Ledger Store::Impl::ledger(std::int64_t run_id) {
   return *row;
 }
 
+namespace {
+
+// The lease as a refused write describes it.
+std::string describe(const std::optional<detail::LeaseState>& state) {
+  if (!state) return "no lease";
+  std::string text = "held by " + state->lease.holder;
+  if (state->remaining_ns <= 0)
+    text += ", expired " + std::to_string(-state->remaining_ns / 1000000) + " ms ago";
+  return text;
+}
+
+}  // namespace
+
+std::unique_ptr<detail::Backend::Transaction> Store::Impl::begin_write(const std::string& vehicle) {
+  auto transaction = backend->begin();
+  if (options.holder.empty()) return transaction;
+  const auto state = backend->lease_for_write(vehicle);
+  if (state && state->lease.holder == options.holder && state->remaining_ns > 0) return transaction;
+  throw NotHolderError(name() + ": vehicle " + vehicle + ": " + options.holder +
+                       " does not hold its lease (" + describe(state) + "); nothing written");
+}
+
 Store::Store(const std::string& location, StoreOptions options)
     : impl_(std::make_unique<Impl>(detail::open_backend(location, options), options)) {}
 Store::~Store() = default;
@@ -75,7 +97,7 @@ AddRunResult Store::add_run(const ingest::RunAnnouncement& announcement) {
       throw InputError("run " + name_of(key) +
                        ": announced again with a different content (channels, rate or models)");
     }
-    const auto transaction = s.backend->begin();
+    const auto transaction = s.begin_write(key.vehicle);
     const auto added = s.backend->insert_run(key, encoded, detail::crc32_of(encoded), now_ns());
     transaction->commit();
     if (added) return AddRunResult::added;
@@ -91,7 +113,7 @@ ingest::RunAnnouncement Store::announcement(const RunKey& key) {
 void Store::close_run(const RunKey& key) {
   Impl& s = *impl_;
   const std::int64_t run_id = s.run(key).id;
-  const auto transaction = s.backend->begin();
+  const auto transaction = s.begin_write(key.vehicle);
   s.backend->close_run(run_id, now_ns());
   transaction->commit();
   s.runs.at(key).closed = true;
@@ -103,6 +125,31 @@ void Store::batch(const std::function<void(Store&)>& f) {
   const auto transaction = impl_->backend->begin();
   f(*this);
   transaction->commit();
+}
+
+// ---- leases ------------------------------------------------------------------------------
+
+Lease Store::acquire_lease(const std::string& vehicle, const std::string& holder,
+                           std::chrono::milliseconds ttl) {
+  if (vehicle.empty() || holder.empty() || ttl.count() <= 0) {
+    throw InputError(impl_->name() + ": lease of vehicle '" + vehicle + "' for '" + holder +
+                     "': needs a vehicle, a holder and a positive duration");
+  }
+  const auto transaction = impl_->backend->begin();
+  Lease lease = impl_->backend->acquire_lease(
+      vehicle, holder, std::chrono::duration_cast<std::chrono::nanoseconds>(ttl).count());
+  transaction->commit();
+  return lease;
+}
+
+void Store::release_lease(const std::string& vehicle, const std::string& holder) {
+  const auto transaction = impl_->backend->begin();
+  impl_->backend->release_lease(vehicle, holder);
+  transaction->commit();
+}
+
+std::vector<Lease> Store::leases() {
+  return impl_->backend->leases();
 }
 
 // ---- listings and estimates -------------------------------------------------------------
@@ -121,7 +168,7 @@ void Store::record_estimate(const EstimateRecord& estimate) {
     throw InputError("estimate of vehicle " + estimate.vehicle + ": empty model or scope");
   }
   const std::int64_t vehicle = s.vehicle_id(estimate.vehicle);
-  const auto transaction = s.backend->begin();
+  const auto transaction = s.begin_write(estimate.vehicle);
   s.backend->insert_estimate(vehicle, estimate, detail::crc32_of(estimate.encoded));
   transaction->commit();
 }

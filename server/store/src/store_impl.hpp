@@ -37,6 +37,9 @@ struct Store::Impl {
   const detail::RunRow& run(const RunKey& key);
   std::int64_t vehicle_id(const std::string& vehicle);
   detail::Ledger ledger(std::int64_t run_id);
+  /// A write transaction for the vehicle's data; fenced by its lease when options.holder is set
+  /// (store.hpp, Leases): NotHolderError, nothing written, unless the holder holds it.
+  std::unique_ptr<detail::Backend::Transaction> begin_write(const std::string& vehicle);
   /// store_chunk after validation; `bytes` is encode_chunk(chunk) (Ordering in store.hpp).
   StoreChunkResult store_valid(const detail::RunRow& run, const ingest::Chunk& chunk,
                                const std::string& bytes);

@@ -30,4 +30,12 @@ class CorruptionError : public StoreError {
   using StoreError::StoreError;
 };
 
+/// A write of a vehicle whose lease the store's holder does not hold (store.hpp, Leases): the
+/// message names the vehicle, the holder and the lease as it stands; nothing was written. The
+/// server must stop serving that vehicle.
+class NotHolderError : public StoreError {
+ public:
+  explicit NotHolderError(const std::string& message) : StoreError(message, 0) {}
+};
+
 }  // namespace dynid::store

@@ -58,7 +58,22 @@
 // for a closed run, a ledger mark that would fold twice or fold what is not stored: InputError
 // naming what and why, and no state changes.
 //
-// One Store per location and process (the server owns it); not thread-safe: one thread at a time.
+// Leases (issue 20: several servers sharing one database). A lease says which server (its
+// holder id) serves a vehicle until when. acquire_lease() takes a vehicle's lease when it is free
+// or expired, or renews it for its holder; release_lease() gives it up at once (a server that
+// stops). Expiry is judged on one clock: the database server's for PostgreSQL, this machine's
+// for SQLite. A store opened with StoreOptions::holder set is fenced: every write of a vehicle's
+// data (add_run, store_chunk, mark_folded, save_checkpoint, record_estimate, close_run) first
+// checks, inside its own transaction, that the holder holds the vehicle's unexpired lease, else
+// it is NotHolderError (errors.hpp) and writes nothing. In PostgreSQL the check locks the lease
+// row (FOR SHARE) until the write commits, so a takeover waits for the old holder's writes in
+// flight and the old holder writes nothing after it: no chunk is stored or folded by two
+// servers. With holder empty (the default, one server per store) nothing is checked.
+//
+// One Store per location and process (the server owns it); not thread-safe: one thread at a
+// time. (Two Stores on one location, e.g. two servers' clients in a test, are serialised by
+// the database: SQLite's file lock, PostgreSQL's row locks.)
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -97,6 +112,8 @@ struct StoreOptions {
   /// A cap on the file's size in pages (PRAGMA max_page_count; 0 keeps SQLite's). Reaching it
   /// behaves exactly like a full disk: SQLITE_FULL, a StoreError, nothing stored. SQLite only.
   std::int64_t max_pages = 0;
+  /// The server id whose leases fence this store's writes (Leases above); empty: no fencing.
+  std::string holder;
 };
 
 enum class ChunkStatus {
@@ -127,6 +144,12 @@ struct RunInfo {
 struct Checkpoint {
   std::uint64_t folded_through = 0;  ///< state = accumulators after folding 0..folded_through
   std::string state;
+};
+
+struct Lease {
+  std::string vehicle;
+  std::string holder;
+  std::int64_t expires_ns = 0;  ///< nanoseconds since the Unix epoch, on the database's clock
 };
 
 struct EstimateRecord {
@@ -184,6 +207,15 @@ class Store {
   std::vector<RunInfo> list_runs(const std::string& vehicle);
   /// No new chunk is accepted afterwards (duplicates still re-acknowledge). Idempotent.
   void close_run(const RunKey& run);
+  /// Takes the vehicle's lease for `holder` until now + ttl if it is free, expired or already
+  /// holder's (then renewed); returns the lease as it stands afterwards: holder's if taken,
+  /// else the other holder's. ttl must be positive (InputError).
+  Lease acquire_lease(const std::string& vehicle, const std::string& holder,
+                      std::chrono::milliseconds ttl);
+  /// Ends holder's lease of the vehicle now; another holder's is left alone.
+  void release_lease(const std::string& vehicle, const std::string& holder);
+  /// Every lease, expired ones included, by vehicle.
+  std::vector<Lease> leases();
   /// Runs f(*this) as one transaction (see Group commit above); InputError inside a batch.
   /// Meant for the chunk path's writes (store_chunk, mark_folded, save_checkpoint,
   /// record_estimate): close_run's and add_run's run cache is not rolled back with it.
