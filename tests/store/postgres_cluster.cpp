@@ -9,12 +9,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 namespace dynid::store::test {
@@ -94,29 +97,63 @@ std::string tool(const char* name) {
 }  // namespace
 
 PostgresCluster::PostgresCluster() : dir_(make_folder()) {
-  const std::string log = dir_ + "/initdb.log";
-  // --no-sync: only initdb's own final fsync of the fresh files; the server runs with fsync on.
-  if (run({tool("initdb"), "-D", dir_ + "/data", "-U", "dynid", "--auth=trust", "-E", "UTF8",
-           "--no-locale", "--no-sync", "--no-instructions"},
-          log) != 0) {
-    const std::string output = read_text(log);
-    std::filesystem::remove_all(dir_);
-    throw std::runtime_error("initdb failed: " + output);
-  }
+  start_cleaner();
   try {
+    const std::string log = dir_ + "/initdb.log";
+    // --no-sync: only initdb's own final fsync of the fresh files; the server runs with fsync on.
+    if (run({tool("initdb"), "-D", dir_ + "/data", "-U", "dynid", "--auth=trust", "-E", "UTF8",
+             "--no-locale", "--no-sync", "--no-instructions"},
+            log) != 0) {
+      throw std::runtime_error("initdb failed: " + read_text(log));
+    }
     start();
     sql(uri("postgres"), "CREATE DATABASE dynid");
   } catch (...) {
-    stop("immediate");
-    std::filesystem::remove_all(dir_);
+    end_cleaner();
     throw;
   }
 }
 
 PostgresCluster::~PostgresCluster() {
-  stop("immediate");
-  std::error_code ignored;
-  std::filesystem::remove_all(dir_, ignored);
+  end_cleaner();
+}
+
+// A process that waits until the test process's end of a pipe closes (at exit, or when the
+// test is killed, e.g. by ctest's timeout), then stops the server and removes the folder: no
+// server outlives its test. Detached (its own session, reparented, output to /dev/null), so
+// whatever kills the test and its process tree does not kill it, and nobody waits for its
+// output. The pipe is close-on-exec, so the server (started through pg_ctl) does not hold it.
+void PostgresCluster::start_cleaner() {
+  int ends[2];
+  if (pipe2(ends, O_CLOEXEC) != 0) throw std::runtime_error("pipe2 failed");
+  const pid_t child = fork();
+  if (child < 0) throw std::runtime_error("fork failed");
+  if (child == 0) {
+    close(ends[1]);
+    if (setsid() < 0 || fork() != 0) _exit(0);  // the intermediate exits: the cleaner is orphaned
+    const int null = open("/dev/null", O_RDWR);
+    for (const int fd : {STDIN_FILENO, STDOUT_FILENO, STDERR_FILENO}) dup2(null, fd);
+    char byte = 0;
+    for (;;) {
+      const ssize_t n = read(ends[0], &byte, 1);
+      if (n == 0 || (n < 0 && errno != EINTR)) break;
+    }
+    stop("immediate");
+    std::error_code ignored;
+    std::filesystem::remove_all(dir_, ignored);
+    _exit(0);
+  }
+  close(ends[0]);
+  waitpid(child, nullptr, 0);
+  cleaner_pipe_ = ends[1];
+}
+
+// Hands the cleaning to the cleaner and waits (10 s at most) until it has removed the folder.
+void PostgresCluster::end_cleaner() {
+  close(cleaner_pipe_);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (std::filesystem::exists(dir_) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
 }
 
 void PostgresCluster::start() {

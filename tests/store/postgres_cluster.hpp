@@ -8,7 +8,8 @@
 // root, which initdb refuses, the server's files belong to and its programs run as the
 // unprivileged user "nobody" (through runuser). A failure to start throws std::runtime_error
 // carrying the tool's output. The destructor stops the server (immediate: its data is thrown
-// away) and removes the folder.
+// away) and removes the folder; so does a child process of its own if the test process dies
+// first (killed by a timeout, a crash): no server outlives its test.
 #include <string>
 
 namespace dynid::store::test {
@@ -36,10 +37,13 @@ class PostgresCluster {
  private:
   void start();
   void stop(const char* mode);
+  void start_cleaner();
+  void end_cleaner();
 
   std::string dir_;
   int port_ = 0;
   int stores_ = 0;
+  int cleaner_pipe_ = -1;  // closing it starts the cleaner
 };
 
 /// The one cluster of the test process, started on first use, stopped at exit.
