@@ -9,6 +9,7 @@
 #include "dynid/dds/participant.hpp"
 #include "dynid/error.hpp"
 #include "dynid/input/option_checks.hpp"
+#include "dynid/store/location.hpp"
 
 namespace dynid::server {
 
@@ -25,10 +26,11 @@ std::string cyclone_config_uri(const std::string& value) {
 namespace {
 
 // The store is created if absent; an existing path must be a regular file (SQLite on a FIFO
-// or a device would block or fail obscurely).
+// or a device would block or fail obscurely). A postgresql:// URI names a database instead.
 CLI::Validator new_or_regular_file() {
   return CLI::Validator(
       [](std::string& path) -> std::string {
+        if (store::is_postgres_uri(path)) return {};  // a database, not a file
         std::error_code ec;
         if (!std::filesystem::exists(std::filesystem::symlink_status(path, ec))) return {};
         try {
@@ -49,7 +51,7 @@ std::optional<ServerOptions> parse_options(int argc, const char* const* argv) {
   long long publish_ms = o.publish_interval.count();
   CLI::App app{"dynid-server: archives measurement chunks, identifies parameters, publishes "
                "estimates over Cyclone DDS"};
-  app.add_option("--store", o.store_path, "SQLite store file")->required()->check(new_or_regular_file());
+  app.add_option("--store", o.store_path, "SQLite store file, or a postgresql:// URI")->required()->check(new_or_regular_file());
   app.add_option("--cyclone-config", o.cyclone_config,
                  "Cyclone DDS configuration (file, file:// URI or XML)")
       ->required();

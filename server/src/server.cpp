@@ -11,6 +11,7 @@
 #include "dynid/error.hpp"
 #include "dynid/report/excitation_report.hpp"
 #include "dynid/report/json.hpp"
+#include "dynid/store/location.hpp"
 #include "server_impl.hpp"
 
 namespace dynid::server {
@@ -60,7 +61,7 @@ Server::Impl::Impl(ServerOptions opts)
     });
   resume_open_runs();
   spdlog::info("dynid-server: store {}, domain {}, {} workers, shard {}, checkpoint every {}",
-               options.store_path, options.domain, pool.size(), options.shard.to_string(),
+               store::for_messages(options.store_path), options.domain, pool.size(), options.shard.to_string(),
                options.checkpoint_every);
 }
 
@@ -87,7 +88,8 @@ void Server::Impl::refuse_foreign_vehicles() {
     list += (k ? ", " : "") + foreign[k] + " (shard " +
             std::to_string(Shard::owner_of(foreign[k], options.shard.count)) + ")";
   if (foreign.size() > 5) list += ", ...";
-  throw InputError("--shard " + options.shard.to_string() + ": store " + options.store_path + " holds " +
+  throw InputError("--shard " + options.shard.to_string() + ": store " +
+                   store::for_messages(options.store_path) + " holds " +
                    std::to_string(foreign.size()) + " vehicle(s) of other shards: " + list +
                    "; was it written with another --shard? Vehicles do not move between shards "
                    "(docs/DESIGN.md, Scale-out)");

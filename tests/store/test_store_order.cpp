@@ -4,36 +4,14 @@
 
 #include "dynid/error.hpp"
 #include "dynid/store/store.hpp"
-#include "store_test_support.hpp"
+#include "store_contract.hpp"
 
-namespace dynid::store {
+namespace dynid::store::test {
 namespace {
-
-using test::announcement;
-using test::chunk;
 
 const RunKey kRun{"proto-17", "run-1"};
 
-class StoreOrder : public ::testing::Test {
- protected:
-  StoreOrder() : store_(dir_.file("store.db"), options()) {
-    store_.add_run(announcement("proto-17", "run-1"));
-  }
-  static StoreOptions options() {
-    StoreOptions o;
-    o.reorder_window = 8;
-    return o;
-  }
-  StoreChunkResult put(std::uint64_t sequence, int variant = 0) {
-    return store_.store_chunk(chunk("proto-17", "run-1", sequence, 10, variant));
-  }
-  std::uint64_t stored_count() { return store_.list_runs("proto-17").at(0).chunks_stored; }
-
-  test::TempDir dir_;
-  Store store_;
-};
-
-TEST_F(StoreOrder, DuplicateIsReacknowledgedAndConflictChangesNothing) {
+TEST_P(StoreOrder, DuplicateIsReacknowledgedAndConflictChangesNothing) {
   ASSERT_EQ(put(0).status, ChunkStatus::stored);
   ASSERT_EQ(put(1).status, ChunkStatus::stored);
   const auto duplicate = put(0);
@@ -44,11 +22,11 @@ TEST_F(StoreOrder, DuplicateIsReacknowledgedAndConflictChangesNothing) {
   EXPECT_EQ(conflict.status, ChunkStatus::conflict);
   EXPECT_NE(conflict.reason.find("proto-17/run-1#1"), std::string::npos) << conflict.reason;
   EXPECT_EQ(stored_count(), 2u);
-  auto stream = store_.chunks(kRun, 1, 1);
+  auto stream = store_->chunks(kRun, 1, 1);
   EXPECT_TRUE(test::same(*stream.next(), chunk("proto-17", "run-1", 1)));  // the first stays
 }
 
-TEST_F(StoreOrder, ChunksAheadOfAGapAreStoredButNotAcknowledgedUntilTheGapCloses) {
+TEST_P(StoreOrder, ChunksAheadOfAGapAreStoredButNotAcknowledgedUntilTheGapCloses) {
   ASSERT_EQ(put(0).status, ChunkStatus::stored);
   for (std::uint64_t s : {3u, 2u, 5u}) {
     const auto result = put(s);
@@ -61,12 +39,12 @@ TEST_F(StoreOrder, ChunksAheadOfAGapAreStoredButNotAcknowledgedUntilTheGapCloses
   EXPECT_EQ(closing.status, ChunkStatus::stored);
   EXPECT_EQ(closing.contiguous_through, 3u);  // jumps over 2 and 3; 4 still missing
   EXPECT_EQ(put(4).contiguous_through, 5u);
-  EXPECT_EQ(store_.highest_contiguous(kRun), 5u);
-  auto stream = store_.chunks(kRun, 0, 5);
+  EXPECT_EQ(store_->highest_contiguous(kRun), 5u);
+  auto stream = store_->chunks(kRun, 0, 5);
   for (std::uint64_t s = 0; s <= 5; ++s) EXPECT_EQ(stream.next()->sequence, s);
 }
 
-TEST_F(StoreOrder, ChunksBeyondTheWindowAreRefusedAndNotStored) {
+TEST_P(StoreOrder, ChunksBeyondTheWindowAreRefusedAndNotStored) {
   ASSERT_EQ(put(0).status, ChunkStatus::stored);
   // Window 8 after contiguous 0: sequences 1..8 may be stored, 9 may not.
   EXPECT_EQ(put(8).status, ChunkStatus::stored);
@@ -77,19 +55,19 @@ TEST_F(StoreOrder, ChunksBeyondTheWindowAreRefusedAndNotStored) {
   auto absurd = chunk("proto-17", "run-1", 0);
   absurd.sequence = ~std::uint64_t{0};
   absurd.seal();
-  EXPECT_EQ(store_.store_chunk(absurd).status, ChunkStatus::beyond_window);
+  EXPECT_EQ(store_->store_chunk(absurd).status, ChunkStatus::beyond_window);
   EXPECT_EQ(stored_count(), 2u);
 }
 
-TEST_F(StoreOrder, FirstChunkMayArriveLateAndTheAckStaysEmptyUntilThen) {
+TEST_P(StoreOrder, FirstChunkMayArriveLateAndTheAckStaysEmptyUntilThen) {
   const auto early = put(2);
   EXPECT_EQ(early.status, ChunkStatus::stored);
   EXPECT_FALSE(early.contiguous_through.has_value());
-  EXPECT_FALSE(store_.highest_contiguous(kRun).has_value());
-  EXPECT_THROW(store_.chunks(kRun, 0, 0), InputError);
+  EXPECT_FALSE(store_->highest_contiguous(kRun).has_value());
+  EXPECT_THROW(store_->chunks(kRun, 0, 0), InputError);
   EXPECT_EQ(put(1).contiguous_through, std::nullopt);
   EXPECT_EQ(put(0).contiguous_through, 2u);
 }
 
 }  // namespace
-}  // namespace dynid::store
+}  // namespace dynid::store::test

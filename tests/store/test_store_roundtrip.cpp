@@ -1,22 +1,18 @@
-// Round trips through real SQLite files: runs, chunks, ledger marks, checkpoints, estimates,
-// and everything still there after the store is closed and opened again.
+// Round trips through every backend (store_contract.hpp): runs, chunks, ledger marks,
+// checkpoints, estimates, and everything still there after the store is closed and opened again.
 #include <gtest/gtest.h>
 
 #include "dynid/error.hpp"
 #include "dynid/store/store.hpp"
-#include "store_test_support.hpp"
+#include "store_contract.hpp"
 
-namespace dynid::store {
+namespace dynid::store::test {
 namespace {
-
-using test::announcement;
-using test::chunk;
 
 const RunKey kRun{"proto-17", "run-1"};
 
-TEST(StoreRoundTrip, RunsAreAddedOnceAndConflictingAnnouncementsRejected) {
-  test::TempDir dir;
-  Store store(dir.file("store.db"));
+TEST_P(StoreRoundTrip, RunsAreAddedOnceAndConflictingAnnouncementsRejected) {
+  Store store = open();
   EXPECT_EQ(store.add_run(announcement("proto-17", "run-1")), AddRunResult::added);
   EXPECT_EQ(store.add_run(announcement("proto-17", "run-1")), AddRunResult::already_known);
   EXPECT_EQ(store.add_run(announcement("proto-17", "run-2")), AddRunResult::added);
@@ -41,9 +37,8 @@ TEST(StoreRoundTrip, RunsAreAddedOnceAndConflictingAnnouncementsRejected) {
   EXPECT_THROW(store.list_runs("nobody"), InputError);
 }
 
-TEST(StoreRoundTrip, ChunksComeBackBitForBitInOrder) {
-  test::TempDir dir;
-  Store store(dir.file("store.db"));
+TEST_P(StoreRoundTrip, ChunksComeBackBitForBitInOrder) {
+  Store store = open();
   store.add_run(announcement("proto-17", "run-1"));
   for (std::uint64_t s = 0; s < 20; ++s) {
     const auto result = store.store_chunk(chunk("proto-17", "run-1", s));
@@ -55,16 +50,15 @@ TEST(StoreRoundTrip, ChunksComeBackBitForBitInOrder) {
   for (std::uint64_t s = 5; s <= 19; ++s) {
     const auto c = stream.next();
     ASSERT_TRUE(c.has_value()) << s;
-    EXPECT_TRUE(test::same(*c, chunk("proto-17", "run-1", s))) << s;
+    EXPECT_TRUE(same(*c, chunk("proto-17", "run-1", s))) << s;
   }
   EXPECT_FALSE(stream.next().has_value());
   EXPECT_FALSE(store.chunks(kRun, 3, 2).next().has_value());  // empty range
   EXPECT_THROW(store.chunks(kRun, 0, 20), InputError);        // past the contiguous prefix
 }
 
-TEST(StoreRoundTrip, CheckpointsMoveTheFoldedMarkAndFollowTheRules) {
-  test::TempDir dir;
-  Store store(dir.file("store.db"));
+TEST_P(StoreRoundTrip, CheckpointsMoveTheFoldedMarkAndFollowTheRules) {
+  Store store = open();
   store.add_run(announcement("proto-17", "run-1"));
   for (std::uint64_t s = 0; s < 10; ++s) store.store_chunk(chunk("proto-17", "run-1", s));
   EXPECT_FALSE(store.latest_checkpoint(kRun).has_value());
@@ -91,9 +85,8 @@ TEST(StoreRoundTrip, CheckpointsMoveTheFoldedMarkAndFollowTheRules) {
 
 // The server's replay: read a chunk, fold it, mark it, checkpoint now and then, store new
 // chunks as they arrive, all while the stream is open on the same connection.
-TEST(StoreRoundTrip, ReplayMarksFoldsCheckpointsAndStoresWhileStreaming) {
-  test::TempDir dir;
-  Store store(dir.file("store.db"));
+TEST_P(StoreRoundTrip, ReplayMarksFoldsCheckpointsAndStoresWhileStreaming) {
+  Store store = open();
   store.add_run(announcement("proto-17", "run-1"));
   for (std::uint64_t s = 0; s < 6; ++s) store.store_chunk(chunk("proto-17", "run-1", s));
   auto stream = store.chunks(kRun, 0, 5);
@@ -110,9 +103,8 @@ TEST(StoreRoundTrip, ReplayMarksFoldsCheckpointsAndStoresWhileStreaming) {
   EXPECT_EQ(store.highest_contiguous(kRun), 11u);
 }
 
-TEST(StoreRoundTrip, EstimateHistoryKeepsEveryRecordInTimeOrder) {
-  test::TempDir dir;
-  Store store(dir.file("store.db"));
+TEST_P(StoreRoundTrip, EstimateHistoryKeepsEveryRecordInTimeOrder) {
+  Store store = open();
   store.add_run(announcement("proto-17", "run-1"));
   store.record_estimate({"proto-17", "lateral_bicycle", "run-1", 2000, "table B"});
   store.record_estimate({"proto-17", "lateral_bicycle", "run-1", 1000, "table A"});
@@ -125,11 +117,9 @@ TEST(StoreRoundTrip, EstimateHistoryKeepsEveryRecordInTimeOrder) {
   EXPECT_THROW(store.record_estimate({"unknown", "m", "run-1", 1, "x"}), InputError);
 }
 
-TEST(StoreRoundTrip, EverythingSurvivesCloseAndReopenAndFoldsRestartAtTheCheckpoint) {
-  test::TempDir dir;
-  const std::string path = dir.file("store.db");
+TEST_P(StoreRoundTrip, EverythingSurvivesCloseAndReopenAndFoldsRestartAtTheCheckpoint) {
   {
-    Store store(path);
+    Store store = open();
     store.add_run(announcement("proto-17", "run-1"));
     for (std::uint64_t s = 0; s < 8; ++s) store.store_chunk(chunk("proto-17", "run-1", s));
     store.store_chunk(chunk("proto-17", "run-1", 10));  // ahead of a gap
@@ -138,7 +128,7 @@ TEST(StoreRoundTrip, EverythingSurvivesCloseAndReopenAndFoldsRestartAtTheCheckpo
     store.record_estimate({"proto-17", "lateral_bicycle", "run-1", 5, "estimate"});
     store.close_run({"proto-17", "run-1"});
   }
-  Store store(path);
+  Store store = open();
   EXPECT_EQ(store.highest_contiguous(kRun), 7u);
   EXPECT_EQ(store.folded_through(kRun), 3u);
   EXPECT_EQ(store.latest_checkpoint(kRun)->state, "checkpoint");
@@ -149,10 +139,10 @@ TEST(StoreRoundTrip, EverythingSurvivesCloseAndReopenAndFoldsRestartAtTheCheckpo
   EXPECT_EQ(store.estimate_history("proto-17", "lateral_bicycle").at(0).encoded, "estimate");
   auto stream = store.chunks(kRun, 4, 7);  // the replay after the checkpoint
   for (std::uint64_t s = 4; s <= 7; ++s) {
-    EXPECT_TRUE(test::same(*stream.next(), chunk("proto-17", "run-1", s)));
+    EXPECT_TRUE(same(*stream.next(), chunk("proto-17", "run-1", s)));
   }
   EXPECT_FALSE(stream.next().has_value());
 }
 
 }  // namespace
-}  // namespace dynid::store
+}  // namespace dynid::store::test

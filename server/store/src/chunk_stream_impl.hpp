@@ -1,21 +1,23 @@
 #pragma once
-// The state behind a ChunkStream, private to the store: its own prepared statement over the
-// store's connection (so two streams, or a stream and the store's writes, never share one),
-// and the next sequence it expects, which is how a missing row is noticed.
+// The state behind a ChunkStream, private to the store: the backend's rows of the range
+// (backend.hpp: ChunkRows, read a bounded number at a time), and the next sequence it expects,
+// which is how a missing row is noticed.
 #include <cstdint>
+#include <memory>
+#include <string>
 
+#include "backend.hpp"
 #include "dynid/store/chunk_stream.hpp"
 #include "dynid/store/store.hpp"
-#include "sqlite.hpp"
 
 namespace dynid::store {
 
 struct ChunkStream::Impl {
-  Impl(detail::Database& database, RunKey run_key, std::int64_t run_id, std::uint64_t from,
+  Impl(detail::Backend& backend, RunKey run_key, std::int64_t run_id, std::uint64_t from,
        std::uint64_t to);
 
-  detail::Database& db;
-  detail::Statement select;
+  std::string store_name;  // "store <location>", for messages
+  std::unique_ptr<detail::ChunkRows> rows;
   RunKey key;
   std::uint64_t expected;
   std::uint64_t last;

@@ -20,45 +20,28 @@ bool within_window(std::uint64_t sequence, std::int64_t contiguous, std::uint64_
   return sequence < next || sequence - next < window;
 }
 
-}  // namespace
-
 // The stored bytes of a sequence, if any (a sequence beyond int64 is never stored).
-std::optional<std::string> Store::Impl::stored_bytes(std::int64_t run_id, std::uint64_t sequence) {
+std::optional<std::string> stored_bytes(detail::Backend& backend, std::int64_t run_id,
+                                        std::uint64_t sequence) {
   if (sequence > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())) {
     return std::nullopt;
   }
-  detail::Query query(find_chunk);
-  query->bind(1, run_id).bind(2, static_cast<std::int64_t>(sequence));
-  if (!query->step()) return std::nullopt;
-  return query->column_blob(0);
+  return backend.chunk_bytes(run_id, static_cast<std::int64_t>(sequence));
 }
 
-// After `from` became stored next to the contiguous prefix: the new end of the prefix, past
-// chunks that were stored ahead of the gap.
-std::int64_t Store::Impl::advance_contiguous(std::int64_t run_id, std::int64_t from) {
-  std::int64_t last = from;
-  detail::Query query(chunk_exists);
-  while (query->start().bind(1, run_id).bind(2, last + 1).step()) ++last;
-  return last;
+detail::ChunkColumns columns_of(const ingest::Chunk& chunk) {
+  return {static_cast<std::int64_t>(chunk.sequence),
+          to_db(chunk.first_sample_index, name_of({chunk.vehicle, chunk.run})),
+          static_cast<std::int64_t>(chunk.samples.rows()),
+          static_cast<std::int64_t>(chunk.checksum)};
 }
 
-void Store::Impl::insert(const detail::RunRow& run, const ingest::Chunk& chunk,
-                         const std::string& bytes) {
-  insert_chunk.start()
-      .bind(1, run.id)
-      .bind(2, static_cast<std::int64_t>(chunk.sequence))
-      .bind(3, to_db(chunk.first_sample_index, name_of({chunk.vehicle, chunk.run})))
-      .bind(4, static_cast<std::int64_t>(chunk.samples.rows()))
-      .bind_blob(5, bytes)
-      .bind(6, static_cast<std::int64_t>(chunk.checksum))
-      .bind(7, detail::now_ns())
-      .run();
-}
+}  // namespace
 
 StoreChunkResult Store::store_chunk(const ingest::Chunk& chunk) {
   const detail::RunRow& run = impl_->run({chunk.vehicle, chunk.run});
-  return impl_->store_valid(run, chunk,
-                            ingest::validate_and_encode(chunk, run.announcement, impl_->options.limits));
+  return impl_->store_valid(
+      run, chunk, ingest::validate_and_encode(chunk, run.announcement, impl_->options.limits));
 }
 
 StoreChunkResult Store::store_chunk(const ingest::ValidatedChunk& validated) {
@@ -77,31 +60,30 @@ StoreChunkResult Store::Impl::store_valid(const detail::RunRow& run, const inges
   const RunKey key{chunk.vehicle, chunk.run};
   const std::string label = name_of(key, chunk.sequence);
 
-  detail::Transaction transaction(s.db);  // rolls back on every early return and throw
+  const auto transaction = s.begin_write(key.vehicle);  // rolls back on every return and throw
   const detail::Ledger ledger = s.ledger(run.id);
-  if (const auto stored = s.stored_bytes(run.id, chunk.sequence)) {
+  if (const auto stored = stored_bytes(*s.backend, run.id, chunk.sequence)) {
     if (*stored == bytes) return {ChunkStatus::duplicate, from_db(ledger.contiguous), {}};
     return {ChunkStatus::conflict, from_db(ledger.contiguous),
             "chunk " + label + " is already stored with other content"};
   }
-  if (run.closed) throw InputError("chunk " + label + ": the run is closed");
+  if (run.closed || ledger.closed) throw InputError("chunk " + label + ": the run is closed");
   if (!within_window(chunk.sequence, ledger.contiguous, s.options.reorder_window)) {
     return {ChunkStatus::beyond_window, from_db(ledger.contiguous),
             "chunk " + label + " is more than " + std::to_string(s.options.reorder_window) +
                 " past the contiguous prefix; resend it later"};
   }
   if (static_cast<std::int64_t>(chunk.sequence) <= ledger.contiguous) {
-    throw CorruptionError("store " + s.db.path() + ": chunk " + label +
-                              " is missing although the ledger counts it as stored",
-                          0);
+    throw CorruptionError(
+        s.name() + ": chunk " + label + " is missing although the ledger counts it as stored", 0);
   }
-  s.insert(run, chunk, bytes);
+  s.backend->insert_chunk(run.id, columns_of(chunk), bytes, detail::now_ns());
   std::int64_t contiguous = ledger.contiguous;
   if (static_cast<std::int64_t>(chunk.sequence) == contiguous + 1) {
-    contiguous = s.advance_contiguous(run.id, contiguous + 1);
-    s.set_contiguous.start().bind(1, run.id).bind(2, contiguous).run();
+    contiguous = s.backend->contiguous_from(run.id, contiguous + 1);
+    s.backend->set_contiguous(run.id, contiguous);
   }
-  transaction.commit();
+  transaction->commit();
   return {ChunkStatus::stored, from_db(contiguous), {}};
 }
 
@@ -123,14 +105,14 @@ ChunkStream Store::chunks(const RunKey& key, std::uint64_t from, std::uint64_t t
         (contiguous < 0 ? std::string("none are") : "0.." + std::to_string(contiguous) + " are") +
         " stored contiguously");
   }
-  return ChunkStream(std::make_unique<ChunkStream::Impl>(s.db, key, run_id, from, to));
+  return ChunkStream(std::make_unique<ChunkStream::Impl>(*s.backend, key, run_id, from, to));
 }
 
 void Store::mark_folded(const RunKey& key, std::uint64_t sequence) {
   Impl& s = *impl_;
   const std::int64_t run_id = s.run(key).id;
   const std::int64_t mark = to_db(sequence, name_of(key));
-  detail::Transaction transaction(s.db);
+  const auto transaction = s.begin_write(key.vehicle);
   const detail::Ledger ledger = s.ledger(run_id);
   if (mark > ledger.contiguous) {
     throw InputError("run " + name_of(key) + ": cannot mark #" + std::to_string(sequence) +
@@ -141,8 +123,8 @@ void Store::mark_folded(const RunKey& key, std::uint64_t sequence) {
                      std::to_string(ledger.folded) + " to #" + std::to_string(sequence) +
                      " (chunks would be folded twice)");
   }
-  s.set_folded.start().bind(1, run_id).bind(2, mark).run();
-  transaction.commit();
+  s.backend->set_folded(run_id, mark);
+  transaction->commit();
 }
 
 void Store::save_checkpoint(const RunKey& key, std::uint64_t folded, std::string_view state) {
@@ -151,39 +133,34 @@ void Store::save_checkpoint(const RunKey& key, std::uint64_t folded, std::string
   const std::int64_t mark = to_db(folded, name_of(key));
   const std::string where =
       "checkpoint of run " + name_of(key) + " through #" + std::to_string(folded);
-  detail::Transaction transaction(s.db);
+  const auto transaction = s.begin_write(key.vehicle);
   const detail::Ledger ledger = s.ledger(run_id);
   if (mark > ledger.contiguous) throw InputError(where + ": those chunks are not all stored");
-  if (detail::Query query(s.newest_checkpoint); query->bind(1, run_id).step()) {
-    const std::int64_t newest = query->column_int(0);
-    if (mark < newest) throw InputError(where + ": older than the latest checkpoint");
-    if (mark == newest) {
-      if (query->column_blob(1) == state) return;  // the same again: nothing to do
+  if (const auto newest = s.backend->newest_checkpoint(run_id)) {
+    if (mark < newest->folded_through)
+      throw InputError(where + ": older than the latest checkpoint");
+    if (mark == newest->folded_through) {
+      if (newest->state == state) return;  // the same again: nothing to do
       throw InputError(where + ": a different checkpoint is already saved at that mark");
     }
   }
-  s.insert_checkpoint.start()
-      .bind(1, run_id)
-      .bind(2, mark)
-      .bind_blob(3, state)
-      .bind(4, detail::crc32_of(state))
-      .bind(5, detail::now_ns())
-      .run();
   // Only the newest is ever loaded; if it were damaged, the chunks (the truth) replay from #0.
-  s.prune_checkpoints.start().bind(1, run_id).bind(2, mark).run();
-  s.set_folded.start().bind(1, run_id).bind(2, std::max(mark, ledger.folded)).run();
-  transaction.commit();
+  s.backend->replace_checkpoints(run_id, {mark, std::string(state), detail::crc32_of(state)},
+                                 detail::now_ns());
+  s.backend->set_folded(run_id, std::max(mark, ledger.folded));
+  transaction->commit();
 }
 
 std::optional<Checkpoint> Store::latest_checkpoint(const RunKey& key) {
   Impl& s = *impl_;
   const std::int64_t run_id = s.run(key).id;
-  detail::Query newest(s.newest_checkpoint);
-  if (!newest->bind(1, run_id).step()) return std::nullopt;
-  Checkpoint checkpoint{static_cast<std::uint64_t>(newest->column_int(0)), newest->column_blob(1)};
-  if (detail::crc32_of(checkpoint.state) != newest->column_int(2)) {
-    throw CorruptionError("store " + s.db.path() + ": checkpoint of run " + name_of(key) +
-                              " through #" + std::to_string(checkpoint.folded_through) +
+  auto newest = s.backend->newest_checkpoint(run_id);
+  if (!newest) return std::nullopt;
+  Checkpoint checkpoint{static_cast<std::uint64_t>(newest->folded_through),
+                        std::move(newest->state)};
+  if (detail::crc32_of(checkpoint.state) != newest->crc) {
+    throw CorruptionError(s.name() + ": checkpoint of run " + name_of(key) + " through #" +
+                              std::to_string(checkpoint.folded_through) +
                               " is damaged (CRC mismatch); the chunks remain, replay from #0",
                           0);
   }

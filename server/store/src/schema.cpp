@@ -94,10 +94,21 @@ ALTER TABLE chunks_v2 RENAME TO chunks;
 INSERT INTO schema_version (version) VALUES (2);
 )sql";
 
+// Version 3: leases (store.hpp, Leases): which server serves a vehicle until when.
+constexpr const char* kVersion3 = R"sql(
+CREATE TABLE leases (
+  vehicle    TEXT PRIMARY KEY,
+  holder     TEXT NOT NULL,
+  expires_ns INTEGER NOT NULL
+);
+INSERT INTO schema_version (version) VALUES (3);
+)sql";
+
 // migrations[v] takes a file from version v to v + 1 (v = 0 is the empty file). A later
 // version appends its script here and bumps kSchemaVersion; the script also updates
 // schema_version.
-constexpr std::array<const char*, kSchemaVersion> kMigrations = {kVersion1, kVersion2};
+constexpr std::array<const char*, kSchemaVersion> kMigrations = {kVersion1, kVersion2,
+                                                                  kVersion3};
 
 std::int64_t pragma_int(Database& db, const char* sql) {
   Statement statement(db, sql);

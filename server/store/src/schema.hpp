@@ -9,7 +9,7 @@
 
 namespace dynid::store::detail {
 
-inline constexpr int kSchemaVersion = 2;
+inline constexpr int kSchemaVersion = 3;
 
 void bring_up_to_date(Database& db);
 

@@ -46,7 +46,7 @@ inline constexpr std::uint64_t kMaxReorderWindow = 1000000;
 inline constexpr long long kMaxLiveResidualS = 86400;
 
 struct ServerOptions {
-  std::string store_path;
+  std::string store_path;  ///< --store: an SQLite file or a postgresql:// URI (store/location.hpp)
   std::string cyclone_config;  ///< as given; see cyclone_config_uri()
   dds_domainid_t domain = 0;
   unsigned threads = 0;

@@ -6,8 +6,9 @@
 // is checked as it is read: decode_chunk verifies its checksum, and the decoded vehicle, run,
 // sequence, first sample index, row count and checksum must match the row's own columns. A
 // mismatch, undecodable bytes or a sequence missing inside the range throws CorruptionError
-// naming the file and vehicle/run#sequence: a damaged chunk is never handed out. The stream
-// reads through its Store's connection: the Store must outlive it, and one thread uses both.
+// naming the store and vehicle/run#sequence: a damaged chunk is never handed out. The stream
+// reads through its Store's connection (SQLite: row by row; PostgreSQL: a few chunks per query):
+// the Store must outlive it, and one thread uses both.
 #include <cstdint>
 #include <memory>
 #include <optional>

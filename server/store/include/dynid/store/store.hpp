@@ -1,15 +1,24 @@
 #pragma once
-// Store: the server's durable archive (one SQLite file) of vehicles, run announcements, raw
-// chunks (the source of truth), the per-run ledger, accumulator checkpoints and estimate history.
+// Store: the server's durable archive of vehicles, run announcements, raw chunks (the source of
+// truth), the per-run ledger, accumulator checkpoints and estimate history.
 //
-// Durability. The file is in WAL mode with synchronous=FULL on every commit: a write function
-// that returns has had its transaction appended to the write-ahead log and fsync'd. So once
+// Backends. The location names where (location.hpp): a file path is one SQLite file, the
+// embedded default for one server; a postgresql:// URI is a PostgreSQL database. Every rule
+// below holds for both; what differs is said where it does. The rules live here, once; a
+// backend only reads and writes rows (src/backend.hpp).
+//
+// Durability. SQLite: the file is in WAL mode with synchronous=FULL on every commit: a write
+// function that returns has had its transaction appended to the write-ahead log and fsync'd.
+// PostgreSQL: the session runs with synchronous_commit = on, so a commit returns once the
+// server has flushed its WAL, and a server running with fsync = off is refused on open. So once
 // store_chunk() returns `stored` or `duplicate`, the chunk survives a crash of the process
 // (SIGKILL included) and of the operating system or a power cut, as far as the disk honours
 // fsync. That is the point at which the server may acknowledge it, and the only one. Every
-// write path is one transaction (BEGIN IMMEDIATE ... COMMIT): a write that throws has been
-// rolled back and leaves nothing half-written. A full disk (SQLITE_FULL) or an I/O error is a
-// StoreError naming the file; the chunk is then not stored and must not be acknowledged.
+// write path is one transaction (SQLite: BEGIN IMMEDIATE ... COMMIT; PostgreSQL: BEGIN ...
+// COMMIT with the run's ledger row locked, so several servers writing one run are serialised):
+// a write that throws has been rolled back and leaves nothing half-written. A full disk
+// (SQLITE_FULL; PostgreSQL's SQLSTATE 53100), an I/O error or a lost connection is a StoreError
+// naming the location; the chunk is then not stored and must not be acknowledged.
 //
 // Group commit (batch). batch(f) runs f inside one transaction: every write f makes is then a
 // savepoint of it (a write that throws is rolled back alone, as above; the others stay), and
@@ -36,8 +45,9 @@
 // Only a run's newest checkpoint is kept. A damaged one is reported (CorruptionError), and the
 // run can still be rebuilt by replaying its chunks from #0.
 //
-// Integrity. On open, PRAGMA quick_check (or integrity_check, or none: StoreOptions) must pass,
-// else CorruptionError naming the file. Every blob carries a CRC-32 that is checked when it
+// Integrity. On open, SQLite's PRAGMA quick_check (or integrity_check, or none: StoreOptions)
+// must pass, else CorruptionError naming the file (PostgreSQL checks its own pages; data it
+// reports damaged, SQLSTATE XX001/XX002, is a CorruptionError too). Every blob carries a CRC-32 that is checked when it
 // is read back (a chunk's is its own checksum, kept in the row and inside the bytes, checked by
 // decode_chunk; the decoded ids, sequence, grid index and row count must match the row too): a
 // damaged row is reported as CorruptionError naming the file and vehicle/run/sequence, never
@@ -48,7 +58,22 @@
 // for a closed run, a ledger mark that would fold twice or fold what is not stored: InputError
 // naming what and why, and no state changes.
 //
-// One Store per file and process (the server owns it); not thread-safe: one thread at a time.
+// Leases (issue 20: several servers sharing one database). A lease says which server (its
+// holder id) serves a vehicle until when. acquire_lease() takes a vehicle's lease when it is free
+// or expired, or renews it for its holder; release_lease() gives it up at once (a server that
+// stops). Expiry is judged on one clock: the database server's for PostgreSQL, this machine's
+// for SQLite. A store opened with StoreOptions::holder set is fenced: every write of a vehicle's
+// data (add_run, store_chunk, mark_folded, save_checkpoint, record_estimate, close_run) first
+// checks, inside its own transaction, that the holder holds the vehicle's unexpired lease, else
+// it is NotHolderError (errors.hpp) and writes nothing. In PostgreSQL the check locks the lease
+// row (FOR SHARE) until the write commits, so a takeover waits for the old holder's writes in
+// flight and the old holder writes nothing after it: no chunk is stored or folded by two
+// servers. With holder empty (the default, one server per store) nothing is checked.
+//
+// One Store per location and process (the server owns it); not thread-safe: one thread at a
+// time. (Two Stores on one location, e.g. two servers' clients in a test, are serialised by
+// the database: SQLite's file lock, PostgreSQL's row locks.)
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -74,17 +99,21 @@ struct RunKey {
 struct StoreOptions {
   enum class Check { none, quick, full };
   /// What to verify on open: quick_check (O(file), skips index/content cross-checks) by default.
+  /// SQLite only.
   Check check_on_open = Check::quick;
   /// A chunk is stored if its sequence < highest contiguous + 1 + reorder_window (>= 1; 1 means
   /// strictly in order).
   std::uint64_t reorder_window = 256;
   /// Passed to ingest::validate_chunk.
   ingest::ChunkLimits limits;
-  /// How long to wait for a lock held by another connection before SQLITE_BUSY.
+  /// How long to wait for a lock held by another connection before SQLITE_BUSY (PostgreSQL:
+  /// the session's lock_timeout).
   int busy_timeout_ms = 5000;
   /// A cap on the file's size in pages (PRAGMA max_page_count; 0 keeps SQLite's). Reaching it
-  /// behaves exactly like a full disk: SQLITE_FULL, a StoreError, nothing stored.
+  /// behaves exactly like a full disk: SQLITE_FULL, a StoreError, nothing stored. SQLite only.
   std::int64_t max_pages = 0;
+  /// The server id whose leases fence this store's writes (Leases above); empty: no fencing.
+  std::string holder;
 };
 
 enum class ChunkStatus {
@@ -117,6 +146,12 @@ struct Checkpoint {
   std::string state;
 };
 
+struct Lease {
+  std::string vehicle;
+  std::string holder;
+  std::int64_t expires_ns = 0;  ///< nanoseconds since the Unix epoch, on the database's clock
+};
+
 struct EstimateRecord {
   std::string vehicle;
   std::string model;
@@ -127,13 +162,15 @@ struct EstimateRecord {
 
 class Store {
  public:
-  /// Opens or creates the file, checks it, brings its schema up to date and resets the folded
-  /// marks to the checkpoints. StoreError/CorruptionError name the file.
-  explicit Store(const std::string& path, StoreOptions options = {});
+  /// Opens the location's backend (a file path or a postgresql:// URI: location.hpp), creating
+  /// the file or schema if absent, checks it, brings its schema up to date and resets the
+  /// folded marks to the checkpoints. StoreError/CorruptionError name the location.
+  explicit Store(const std::string& location, StoreOptions options = {});
   ~Store();
   Store(Store&&) noexcept;
   Store& operator=(Store&&) noexcept;
 
+  /// The location as given (a path or a URI).
   const std::string& path() const;
 
   /// Records a run (and its vehicle on first sight) after announcement.validate(). The same
@@ -170,6 +207,15 @@ class Store {
   std::vector<RunInfo> list_runs(const std::string& vehicle);
   /// No new chunk is accepted afterwards (duplicates still re-acknowledge). Idempotent.
   void close_run(const RunKey& run);
+  /// Takes the vehicle's lease for `holder` until now + ttl if it is free, expired or already
+  /// holder's (then renewed); returns the lease as it stands afterwards: holder's if taken,
+  /// else the other holder's. ttl must be positive (InputError).
+  Lease acquire_lease(const std::string& vehicle, const std::string& holder,
+                      std::chrono::milliseconds ttl);
+  /// Ends holder's lease of the vehicle now; another holder's is left alone.
+  void release_lease(const std::string& vehicle, const std::string& holder);
+  /// Every lease, expired ones included, by vehicle.
+  std::vector<Lease> leases();
   /// Runs f(*this) as one transaction (see Group commit above); InputError inside a batch.
   /// Meant for the chunk path's writes (store_chunk, mark_folded, save_checkpoint,
   /// record_estimate): close_run's and add_run's run cache is not rolled back with it.
