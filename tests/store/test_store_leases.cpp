@@ -14,7 +14,7 @@ namespace {
 
 using namespace std::chrono_literals;
 
-constexpr auto kTtl = 300ms;
+constexpr auto kTtl = 1000ms;  // long against a store write under the sanitizers and a loaded disk
 
 StoreOptions held_by(const std::string& holder) {
   StoreOptions options;
