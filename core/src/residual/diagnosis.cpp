@@ -387,13 +387,19 @@ void accept_best(Diagnosis& d, const FloorInputs& in, bool at_floor = false) {
     floors.emplace(c.effect, own);
   }
   if (at_floor) missing.clear(), partial.clear();
-  std::vector<CandidateScore>& chosen = !missing.empty() ? missing : !partial.empty() ? partial : sensors_better;
+  std::vector<CandidateScore> sensors_reaching;
+  for (const CandidateScore& c : sensors_better)
+    if (floors.at(c.effect).reaches) sensors_reaching.push_back(c);
+  std::vector<CandidateScore>& chosen = !missing.empty()          ? missing
+                                        : !sensors_reaching.empty() ? sensors_reaching
+                                        : !partial.empty()          ? partial
+                                                                    : sensors_better;
   if (chosen.empty()) return;
   prefer_simplest_within_one_error(chosen);
   d.accepted = chosen.front();
   const OwnFloor& own = floors.at(d.accepted->effect);
   if (!own.reaches) d.partial = own.worst;
-  if (&chosen != &sensors_better)
+  if (&chosen == &missing || &chosen == &partial)
     for (const CandidateScore& c : sensors_better)
       d.refused.push_back({c.effect, "passed over for " + d.accepted->effect +
                                          ": it lowers the noise floor (a better sensor of a declared signal), " +
