@@ -109,6 +109,7 @@ ChannelMapping source_mapping(const AuxiliarySourceSpec& spec, std::size_t si, s
   m.unit = c.unit;
   m.message = spec.name + "." + c.column;
   m.max_gap = c.max_gap;
+  m.interpolation = c.interpolation;
   m.gain = c.gain;
   m.source = si;
   m.source_channel = ci;

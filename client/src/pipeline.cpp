@@ -11,7 +11,10 @@ ResamplerConfig resampler_config(const VehicleProfile& p) {
   c.rate_hz = p.rate_hz;
   c.channels = p.channels.size();
   c.max_gap_periods = p.max_gap_periods;
-  for (const auto& m : p.channels) c.max_gap.push_back(m.max_gap);
+  for (const auto& m : p.channels) {
+    c.max_gap.push_back(m.max_gap);
+    c.interpolation.push_back(m.interpolation);
+  }
   c.jumps.forward = p.max_time_jump;
   c.jumps.backward = c.max_latency;  // older frames could only join rows already emitted
   return c;

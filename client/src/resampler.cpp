@@ -16,6 +16,9 @@ void check_config(const ResamplerConfig& c) {
   if (!c.max_gap.empty() && c.max_gap.size() != c.channels)
     throw InputError("resampler: max_gap has " + std::to_string(c.max_gap.size()) + " entries for " +
                      std::to_string(c.channels) + " channels");
+  if (!c.interpolation.empty() && c.interpolation.size() != c.channels)
+    throw InputError("resampler: interpolation has " + std::to_string(c.interpolation.size()) + " entries for " +
+                     std::to_string(c.channels) + " channels");
   for (const auto& g : c.max_gap)
     if (g && !(*g > 0.0)) throw InputError("resampler: a max_gap must be > 0");
 }
@@ -26,6 +29,7 @@ Resampler::Resampler(ResamplerConfig config, RowSink sink)
     : config_(std::move(config)), sink_(std::move(sink)), source_clock_(config_.jumps) {
   check_config(config_);
   if (config_.max_gap.empty()) config_.max_gap.resize(config_.channels);
+  if (config_.interpolation.empty()) config_.interpolation.resize(config_.channels, Interpolation::kLinear);
   channels_.resize(config_.channels);
   row_.resize(config_.channels);
   stats_.missing_by_channel.assign(config_.channels, 0);
@@ -58,7 +62,7 @@ void Resampler::end_piece() {
   }
   origin_.reset();
   std::fill(channels_.begin(), channels_.end(), Channel{});
-  clock_ = -std::numeric_limits<double>::infinity();
+  clock_ = frame_clock_ = -std::numeric_limits<double>::infinity();
 }
 
 void Resampler::push(std::size_t channel, double time, double value) {
@@ -77,12 +81,14 @@ void Resampler::push(std::size_t channel, double time, double value) {
   }
   c.samples.push_back({time, value, bridgeable});
   clock_ = std::max(clock_, time);
+  frame_clock_ = std::max(frame_clock_, time);
   emit_ready();
 }
 
 void Resampler::advance_clock(double time) {
   observe(time);
   clock_ = std::max(clock_, time);
+  frame_clock_ = std::max(frame_clock_, time);
   emit_ready();
 }
 
@@ -120,7 +126,15 @@ double Resampler::stale_after(std::size_t channel, const Channel& c) const {
 
 bool Resampler::decided(std::size_t channel, double t) const {
   const Channel& c = channels_[channel];
-  if (!c.samples.empty() && c.samples.back().time >= t) return true;
+  if (!c.samples.empty() && c.samples.back().time >= t) {
+    if (config_.interpolation[channel] == Interpolation::kLinear) return true;
+    // Cubic: b's successor gives b's slope (header); waited for by the frames' clock.
+    const auto b = std::lower_bound(c.samples.begin(), c.samples.end(), t,
+                                    [](const Sample& s, double x) { return s.time < x; });
+    if (b->time == t || std::next(b) != c.samples.end()) return true;
+    if (clock_ > t + config_.max_latency) return true;
+    return frame_clock_ > b->time + stale_after(channel, c);
+  }
   // Verdicts of "missing" only for times the source clock has reached, so that a stream whose
   // channels are all stale does not run ahead of its own data.
   if (t > clock_) return false;
@@ -128,14 +142,34 @@ bool Resampler::decided(std::size_t channel, double t) const {
   return !c.samples.empty() && clock_ > c.samples.back().time + stale_after(channel, c);
 }
 
-std::optional<double> Resampler::value_at(const Channel& c, double t) const {
+std::optional<double> Resampler::value_at(std::size_t channel, double t) const {
+  const Channel& c = channels_[channel];
   const auto b = std::lower_bound(c.samples.begin(), c.samples.end(), t,
                                   [](const Sample& s, double x) { return s.time < x; });
   if (b == c.samples.end()) return std::nullopt;  // past the last sample: no extrapolation
   if (b->time == t) return b->value;
   if (b == c.samples.begin() || !b->bridgeable) return std::nullopt;  // before data, or a gap
   const auto a = std::prev(b);
-  return a->value + (b->value - a->value) * ((t - a->time) / (b->time - a->time));
+  const double h = b->time - a->time;
+  const double u = (t - a->time) / h;
+  if (config_.interpolation[channel] == Interpolation::kLinear) return a->value + (b->value - a->value) * u;
+  // Cubic Hermite; each end's slope from the parabola through it and its neighbours (header).
+  const double secant = (b->value - a->value) / h;
+  double slope_a = secant;
+  double slope_b = secant;
+  if (a != c.samples.begin() && a->bridgeable) {
+    const auto before = std::prev(a);
+    const double h0 = a->time - before->time;
+    slope_a = ((a->value - before->value) / h0 * h + secant * h0) / (h0 + h);
+  }
+  if (const auto after = std::next(b); after != c.samples.end() && after->bridgeable) {
+    const double h1 = after->time - b->time;
+    slope_b = (secant * h1 + (after->value - b->value) / h1 * h) / (h + h1);
+  }
+  const double u2 = u * u;
+  const double u3 = u2 * u;
+  return (2 * u3 - 3 * u2 + 1) * a->value + (u3 - 2 * u2 + u) * h * slope_a + (3 * u2 - 2 * u3) * b->value +
+         (u3 - u2) * h * slope_b;
 }
 
 void Resampler::emit_ready() {
@@ -167,7 +201,7 @@ void Resampler::emit_reached() {
 void Resampler::emit_row(double t) {
   bool valid = true;
   for (std::size_t i = 0; i < channels_.size(); ++i) {
-    const auto v = value_at(channels_[i], t);
+    const auto v = value_at(i, t);
     row_[i] = v.value_or(0.0);
     if (!v) {
       valid = false;
@@ -188,9 +222,10 @@ void Resampler::deliver(bool valid) {
   ++next_row_;
 }
 
-// Keeps the last sample at or before `t` (the lower bracket of the next row) and all after it.
+// Keeps the last two samples at or before `t` (the lower bracket of the next row and, for a
+// cubic channel, its predecessor) and all after it.
 void Resampler::prune(Channel& c, double t) {
-  while (c.samples.size() >= 2 && c.samples[1].time <= t) c.samples.pop_front();
+  while (c.samples.size() >= 3 && c.samples[2].time <= t) c.samples.pop_front();
 }
 
 }  // namespace dynid::car

@@ -272,11 +272,11 @@ ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml
                             const std::string& key, bool in_source = false) {
   if (in_source)  // a channel of a second bus (type = "can" source)
     r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
-                    "scale", "divide_by", "sign", "max_gap", "replaces_bus"},
+                    "scale", "divide_by", "sign", "max_gap", "interpolation", "replaces_bus"},
                 key + ".");
   else
     r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
-                    "scale", "divide_by", "sign", "max_gap"},
+                    "scale", "divide_by", "sign", "max_gap", "interpolation"},
                 key + ".");
   ChannelMapping m;
   m.channel = r.string(t, "name", key + ".name");
@@ -308,6 +308,12 @@ ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml
   if (const toml::node* d = t.get("divide_by")) m.gain /= gain_term(r, p, *d, key + ".divide_by");
   m.gain *= read_sign(r, t, key);
   if (t.contains("max_gap")) m.max_gap = r.at_most(t, "max_gap", key + ".max_gap", kMaxSeconds);
+  if (const toml::node* i = t.get("interpolation")) {
+    const auto v = i->value<std::string>();
+    if (!i->is_string() || (*v != "linear" && *v != "cubic"))
+      r.fail(key + ".interpolation", "expected \"linear\" or \"cubic\"", i);
+    m.interpolation = *v == "cubic" ? Interpolation::kCubic : Interpolation::kLinear;
+  }
   return m;
 }
 
@@ -478,6 +484,7 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
         c.channel = m.channel;
         c.unit = m.unit;
         c.max_gap = m.max_gap;
+        c.interpolation = m.interpolation;
         c.replaces_bus = read_bool(r, ct, "replaces_bus", ckey);
         bus->channels.push_back(std::move(m));
       } else {

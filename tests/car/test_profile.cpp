@@ -188,6 +188,8 @@ TEST(CarProfile, BadTypesAndValues) {
   expect_error(replace(kGood, "combine = \"mean\"", "combine = \"median\""), ":21:", "channels[0].combine",
                "expected \"sum\" or \"mean\"");
   expect_error(replace(kGood, "combine = \"mean\"", "sign = 2"), ":21:", "channels[0].sign", "expected 1 or -1");
+  expect_error(replace(kGood, "combine = \"mean\"", "interpolation = \"spline\""), ":21:",
+               "channels[0].interpolation", "expected \"linear\" or \"cubic\"");
   expect_error(replace(kGood, "signals = [\"WhlSpd_FL\"", "signals = [3"), ":20:", "channels[0].signals[0]",
                "expected a string");
   expect_error(replace(kGood, "id = \"t\"", "id = 7"), ":3:", "vehicle.id", "expected a string");
@@ -195,6 +197,15 @@ TEST(CarProfile, BadTypesAndValues) {
   expect_error(replace(kGood, "combine = \"mean\"", "combin = \"mean\""), ":21:", "channels[0].combin",
                "unknown key");
   expect_error(replace(kGood, "a = 1.0", "a = nan"), ":13:", "constants.a", "must be finite");
+}
+
+TEST(CarProfile, AChannelIsInterpolatedLinearlyUnlessItsMappingSaysCubic) {
+  const auto linear = parse_vehicle_profile(kGood, profile_path("broken.toml"));
+  EXPECT_EQ(linear.channels[0].interpolation, Interpolation::kLinear);
+  const auto cubic = parse_vehicle_profile(replace(kGood, "combine = \"mean\"", "combine = \"mean\"\ninterpolation = \"cubic\""),
+                                           profile_path("broken.toml"));
+  EXPECT_EQ(cubic.channels[0].interpolation, Interpolation::kCubic);
+  EXPECT_EQ(cubic.channels[1].interpolation, Interpolation::kLinear);
 }
 
 TEST(CarProfile, ConstantsAndModels) {

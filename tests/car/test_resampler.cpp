@@ -3,6 +3,7 @@
 // contiguous and sealed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -189,6 +190,124 @@ TEST(CarResampler, RejectsBadConfiguration) {
   EXPECT_THROW(Resampler(c, out.sink()), InputError);
   c.max_gap_periods = 0.5;
   c.max_gap.clear();
+  EXPECT_THROW(Resampler(c, out.sink()), InputError);
+}
+
+double quadratic(double t) { return 0.4 - 1.5 * (t - 1000.0) + 2.0 * (t - 1000.0) * (t - 1000.0); }
+
+ResamplerConfig cubic_config(std::size_t channels, double rate, double origin) {
+  ResamplerConfig c = config(channels, rate, origin);
+  c.interpolation.assign(channels, Interpolation::kCubic);
+  return c;
+}
+
+// Pushes a channel's jittered samples of f in one call per `batch` samples, then finishes.
+std::vector<Row> resample_cubic(const std::vector<double>& times, double (*f)(double), std::size_t batch) {
+  Collector out;
+  Resampler r(cubic_config(1, 100.0, 1000.0), out.sink());
+  for (std::size_t i = 0; i < times.size(); i += batch)
+    for (std::size_t j = i; j < std::min(times.size(), i + batch); ++j) r.push(0, times[j], f(times[j]));
+  r.finish();
+  return out.rows;
+}
+
+TEST(CarResampler, CubicChannelsReproduceQuadraticsExactlyBetweenJitteredFrames) {
+  // The parabolas through three frames are the quadratic itself, whatever the spacing, so the
+  // Hermite cubic between two frames is too; linear interpolation misses by the curvature.
+  const auto times = jittered_times(999.8, 1005.0, 0.02, 0.004, 3);
+  const std::vector<Row> rows = resample_cubic(times, quadratic, 1);
+  ASSERT_GT(rows.size(), 490U);
+  std::size_t valid = 0;
+  for (const Row& row : rows) {
+    const double t = 1000.0 + static_cast<double>(row.index) / 100.0;
+    // After the second-to-last frame the end slope is the secant's (no successor): not exact.
+    if (!row.valid || t > times[times.size() - 2]) continue;
+    ++valid;
+    ASSERT_NEAR(row.values[0], quadratic(t), 1e-9) << "row " << row.index;
+  }
+  EXPECT_GT(valid, 490U);
+  Collector linear;
+  Resampler r(config(1, 100.0, 1000.0), linear.sink());
+  for (double t : times) r.push(0, t, quadratic(t));
+  r.finish();
+  double worst = 0.0;
+  for (const Row& row : linear.rows)
+    if (row.valid) worst = std::max(worst, std::abs(row.values[0] - quadratic(1000.0 + static_cast<double>(row.index) / 100.0)));
+  EXPECT_GT(worst, 1e-5);  // 2 x (0.012 s)^2 / 4 where a frame is late
+}
+
+TEST(CarResampler, ACubicSineLosesFarLessThanALinearOneBetweenFrames) {
+  // A 1 Hz sine sent at 50 Hz, a quarter period off a 100 Hz grid (as bench/trace's inertial
+  // message): linear interpolation misses by up to u (1 - u) (w T)^2 / 2 = 0.15 % of the
+  // amplitude at u = 1/4, the cubic by a third-order term, (w T)^3 / 16 at most: 1.2e-4.
+  auto sine = [](double t) { return std::sin(2.0 * 3.141592653589793 * (t - 1000.0)); };
+  std::vector<double> times;
+  for (int n = -10; n < 500; ++n) times.push_back(1000.005 + 0.02 * n);
+  auto worst_error = [&](ResamplerConfig c) {
+    Collector out;
+    Resampler r(c, out.sink());
+    for (double t : times) r.push(0, t, sine(t));
+    r.finish();
+    double worst = 0.0;
+    for (const Row& row : out.rows) {
+      const double t = 1000.0 + static_cast<double>(row.index) / 100.0;
+      if (row.valid && t < times[times.size() - 2]) worst = std::max(worst, std::abs(row.values[0] - sine(t)));
+    }
+    return worst;
+  };
+  const double linear = worst_error(config(1, 100.0, 1000.0));
+  const double cubic = worst_error(cubic_config(1, 100.0, 1000.0));
+  EXPECT_GT(linear, 1e-3);
+  EXPECT_LT(cubic, 1.5e-4);
+  EXPECT_LT(cubic, linear / 8.0);
+}
+
+TEST(CarResampler, CubicRowsDoNotDependOnHowTheFramesAreBatchedOrOnAnIdleClock) {
+  const auto times = jittered_times(999.9, 1003.0, 0.02, 0.003, 4);
+  const std::vector<Row> one = resample_cubic(times, quadratic, 1);
+  const std::vector<Row> many = resample_cubic(times, quadratic, 37);
+  ASSERT_EQ(one.size(), many.size());
+  for (std::size_t k = 0; k < one.size(); ++k) {
+    EXPECT_EQ(one[k].valid, many[k].valid);
+    EXPECT_EQ(one[k].values, many[k].values) << "row " << k;
+  }
+  // A live loop's idle clock running ahead of the frames (a frame in flight) does not decide a
+  // cubic row before its next frame: the row waits for the frames' own clock. 35 ms ahead: less
+  // than the 2.5 periods after which a linear channel's next frame is given up, more than the
+  // 1.5 periods a cubic row's successor is due after them (judged by the idle clock, this row
+  // would be emitted with the secant's slope).
+  Collector live;
+  Resampler r(cubic_config(1, 100.0, 1000.0), live.sink());
+  for (double t : times) {
+    r.idle(t + 0.035);
+    r.push(0, t, quadratic(t));
+  }
+  r.finish();
+  ASSERT_EQ(live.rows.size(), one.size());
+  for (std::size_t k = 0; k < one.size(); ++k) EXPECT_EQ(live.rows[k].values, one[k].values) << "row " << k;
+}
+
+TEST(CarResampler, ACubicChannelWaitsForTheFrameAfterTheBracketAndBridgesNoGap) {
+  Collector out;
+  Resampler r(cubic_config(1, 100.0, 0.0), out.sink());
+  for (int n = 0; n <= 10; ++n) r.push(0, 0.01 * n + 0.005, line0(0.01 * n + 0.005));
+  // Row 10 (t = 0.1) lies between the frames at 0.095 and 0.105: it needs the one after 0.105.
+  ASSERT_EQ(out.rows.size(), 10U);
+  r.push(0, 0.115, line0(0.115));
+  EXPECT_EQ(out.rows.size(), 11U);
+  // A gap: the frames around it are not used as neighbours, and nothing is bridged across it.
+  for (int n = 40; n <= 60; ++n) r.push(0, 0.01 * n + 0.005, line0(0.01 * n + 0.005));
+  r.finish();
+  for (const Row& row : out.rows) {
+    const double t = 0.01 * static_cast<double>(row.index);
+    if (t > 0.115 && t < 0.405) {
+      EXPECT_FALSE(row.valid) << "row " << row.index;
+    } else if (row.valid) {
+      EXPECT_NEAR(row.values[0], line0(t), 1e-12) << "row " << row.index;
+    }
+  }
+  auto c = cubic_config(2, 10.0, 0.0);
+  c.interpolation.pop_back();
   EXPECT_THROW(Resampler(c, out.sink()), InputError);
 }
 

@@ -2,9 +2,20 @@
 // Resampler: timestamped channel samples (irregular, per channel, as CAN delivers them) -> rows
 // of a uniform grid t_k = origin + k / rate, streaming.
 //
-// Interpolation rule: the value of channel c at t_k is the linear interpolation between the two
-// samples a, b of c with t_a <= t_k <= t_b (the sample itself when t_a == t_k), provided that
-// t_b - t_a <= G_c. Otherwise the channel is missing at t_k: nothing is ever interpolated across
+// Interpolation rule: the value of channel c at t_k is interpolated between the two samples a, b
+// of c with t_a <= t_k <= t_b (the sample itself when t_a == t_k), provided that t_b - t_a <= G_c:
+//   linear (the default): the straight line through a and b;
+//   cubic (Interpolation::kCubic, per channel): the cubic Hermite through a and b whose slopes are
+//   those of the parabolas through (a's predecessor, a, b) and (a, b, b's successor): Catmull-Rom
+//   on a uniform grid, exact on quadratics. Where a neighbour is missing or beyond a gap, that
+//   end's slope is the secant's (with both, the line). Why: linear interpolation attenuates a
+//   signal between frames, 1 - u (1 - u) (w T)^2 / 2 at a fraction u of the frame period T: a
+//   50 Hz message read half a period off the grid loses 0.13 % of a 1 Hz sine steer, which biased
+//   a yaw inertia by +0.18 % on noise-free data; the cubic's loss is of order (w T)^4. A channel
+//   that steps (a gear, a status) keeps linear: a cubic overshoots a step by up to 7 %.
+// A cubic channel decides a row one frame later: it waits for b's successor (its slope) until the
+// channel is stale by the frames' own clock (not the live loop's idle clock, which could run
+// ahead of a frame in flight and make a live row differ from its replay) or the latency passes. Otherwise the channel is missing at t_k: nothing is ever interpolated across
 // a gap, and nothing is extrapolated past the last sample or before the first. A row is valid
 // when every channel has a value; an invalid row carries zeros (ingest::Chunk's convention).
 //   G_c = the mapping's max_gap if the profile sets one, else max_gap_periods x the signal's own
@@ -56,11 +67,14 @@
 
 namespace dynid::car {
 
+enum class Interpolation { kLinear, kCubic };
+
 struct ResamplerConfig {
   double rate_hz = 0.0;
   std::size_t channels = 0;
   double max_gap_periods = 2.5;
   std::vector<std::optional<double>> max_gap;  ///< per channel (seconds), or empty
+  std::vector<Interpolation> interpolation;    ///< per channel, or empty (all linear)
   double max_latency = 1.0;                    ///< seconds of source clock
   std::optional<double> origin;                ///< grid time 0; unset: the first sample's time
   TimeJumpLimits jumps;                        ///< where the source clock jumps (see above)
@@ -84,7 +98,7 @@ class Resampler {
   using RowSink = std::function<void(std::uint64_t, std::span<const double>, bool)>;
 
   /// Throws InputError for a non-positive rate, no channel, max_gap_periods < 1, a
-  /// non-positive max_gap or max_latency, a max_gap list of the wrong length, or jump limits
+  /// non-positive max_gap or max_latency, a max_gap or interpolation list of the wrong length, or jump limits
   /// that are not positive and finite.
   Resampler(ResamplerConfig config, RowSink sink);
 
@@ -122,7 +136,7 @@ class Resampler {
   double judge_interval(std::size_t channel, Channel& c, double interval);
   double stale_after(std::size_t channel, const Channel& c) const;
   bool decided(std::size_t channel, double t) const;
-  std::optional<double> value_at(const Channel& c, double t) const;
+  std::optional<double> value_at(std::size_t channel, double t) const;
   void emit_ready();
   void emit_row(double t);
   static void prune(Channel& c, double t);
@@ -135,7 +149,8 @@ class Resampler {
   std::uint64_t piece_first_row_ = 0;
   SourceClock source_clock_;
   bool last_valid_ = false;  // of the last row emitted
-  double clock_ = -std::numeric_limits<double>::infinity();
+  double clock_ = -std::numeric_limits<double>::infinity();       // newest time seen, idle included
+  double frame_clock_ = -std::numeric_limits<double>::infinity();  // newest frame time seen
   std::uint64_t next_row_ = 0;
   std::vector<double> row_;
   ResamplerStats stats_;

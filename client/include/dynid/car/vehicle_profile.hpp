@@ -41,7 +41,10 @@
 //   # optional: signal = "X" (one signal), dbc_unit = "bar" (when the DBC has none or a wrong
 //   # one), factor/offset (explicit DBC -> SI conversion instead of the unit table), scale and
 //   # divide_by (a number or the name of a [constants] entry, e.g. "steering_ratio"),
-//   # sign = -1, max_gap (seconds, at most 3600, instead of the derived window).
+//   # sign = -1, max_gap (seconds, at most 3600, instead of the derived window),
+//   # interpolation = "cubic" (a smooth signal on a slower message: the grid's values between
+//   # frames without linear interpolation's attenuation; "linear", the default, for a signal that
+//   # steps, resampler.hpp).
 //
 //   [[sources]]                        # optional: auxiliary sources besides the bus (auxiliary.hpp)
 //   name = "recorder_imu"              # the id rule (input/ids.hpp); dynid-car --source NAME=FILE
@@ -107,6 +110,7 @@
 #include <dynid/ingest/run_announcement.hpp>
 #include <dynid/model/constants.hpp>
 
+#include "dynid/car/resampler.hpp"
 #include "dynid/car/units.hpp"
 
 namespace dynid::car {
@@ -129,6 +133,7 @@ struct ChannelMapping {
   Combine combine = Combine::Sum;
   double gain = 1.0;    ///< sign * scale / divide_by
   std::optional<double> max_gap;  ///< seconds; unset: derived from the signal's period
+  Interpolation interpolation = Interpolation::kLinear;  ///< between frames (resampler.hpp)
   /// Set for a channel of an auxiliary source (with_sources()): index into
   /// VehicleProfile::sources and into its channels; the bus decoder never sees it.
   std::optional<std::size_t> source;
@@ -149,6 +154,7 @@ struct SourceChannel {
   LinearConversion to_si;
   double gain = 1.0;           ///< sign * scale
   std::optional<double> max_gap;
+  Interpolation interpolation = Interpolation::kLinear;  ///< a second bus's mapping may set it
   bool replaces_bus = false;
 };
 
