@@ -30,6 +30,17 @@ std::string server_of_heartbeat(const std::string& name) {
   return name.starts_with(kHeartbeatPrefix) ? name.substr(kHeartbeatPrefix.size()) : "";
 }
 
+std::map<std::string, std::vector<std::string>> holdings(const std::vector<store::Lease>& leases) {
+  std::map<std::string, std::vector<std::string>> by_server;
+  for (const auto& lease : leases) {
+    const std::string server = server_of_heartbeat(lease.vehicle);
+    auto& vehicles = by_server[server.empty() ? lease.holder : server];
+    if (server.empty()) vehicles.push_back(lease.vehicle);
+  }
+  for (auto& [server, vehicles] : by_server) std::sort(vehicles.begin(), vehicles.end());
+  return by_server;
+}
+
 std::size_t fair_share(std::size_t vehicles, std::size_t servers) {
   const std::size_t s = std::max<std::size_t>(servers, 1);
   return std::max<std::size_t>((vehicles + s - 1) / s, 1);
@@ -229,6 +240,17 @@ void LeaseKeeper::release_all() {
   for (const auto& vehicle : vehicles) release(vehicle);
   release(heartbeat_name(id_));
   spdlog::info("{}: {} leases released", input::printable(id_), vehicles.size());
+}
+
+// Read now, not the renewal's copy: a server that joined since shows at once.
+std::vector<store::Lease> LeaseKeeper::leases() {
+  std::lock_guard lock(mutex_);
+  const std::int64_t database_now =
+      database_now_ns_ + std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - database_now_at_).count();
+  std::vector<store::Lease> live;
+  for (const auto& lease : store_.leases())
+    if (lease.expires_ns > database_now) live.push_back(lease);
+  return live;
 }
 
 }  // namespace dynid::server

@@ -171,8 +171,25 @@ CounterSnapshot Server::counters() const { return impl_->counters.snapshot(); }
 
 // ---- requests ----------------------------------------------------------------------------
 
+// The counters, and with leases which server this is and who holds which vehicle:
+// {..counters.., "server": id, "servers": [{"id": id, "vehicles": [..]}, ..]}.
+std::string Server::Impl::status_reply() {
+  std::string out = counters.snapshot().to_json();
+  if (!leases) return out;
+  out.pop_back();  // the counters' closing brace
+  out += ",\"server\":" + report::json_string(options.server_id) + ",\"servers\":[";
+  bool first_server = true;
+  for (const auto& [server, vehicles] : holdings(leases->leases())) {
+    out += std::string(first_server ? "" : ",") + "{\"id\":" + report::json_string(server) + ",\"vehicles\":[";
+    for (std::size_t k = 0; k < vehicles.size(); ++k) out += (k ? "," : "") + report::json_string(vehicles[k]);
+    out += "]}";
+    first_server = false;
+  }
+  return out + "]}";
+}
+
 std::string Server::Impl::fleet_reply(const ParsedRequest& request) {
-  if (request.kind == "status") return counters.snapshot().to_json();
+  if (request.kind == "status") return status_reply();
   auto vehicles = store.with([](store::Store& s) { return s.list_vehicles(); });
   std::string out;
   for (const auto& v : vehicles)

@@ -66,6 +66,7 @@ struct Server::Impl {
   void dispatch_fleet(const ParsedRequest& request, const dds::Request& raw,
                       const ReplyCache::Key& key);
   std::string fleet_reply(const ParsedRequest& request);
+  std::string status_reply();
   /// Writes `reply` stamped with this server's shard.
   void send(dds::Reply reply);
 

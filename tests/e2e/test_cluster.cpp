@@ -15,7 +15,8 @@
 // - SigtermHandsOverAtOnceAndJoinerTakesShare: with a long TTL (kLongTtl), a server stopped with
 //   SIGTERM releases its leases: its vehicles are acknowledged by the others well before the
 //   TTL could have expired. A server started mid-run then takes vehicles (the others give back
-//   what is above the fair share) and acknowledges them.
+//   what is above the fair share) and acknowledges them; `dynid status` (text and --json) lists
+//   the live servers, the joiner among them, and not the stopped one.
 //
 // kVehicles is 30, as in issue 20, with runs of ~60 chunks over 30 s (50 s in the second test,
 // so that the runs are still going when the fourth server joins).
@@ -27,6 +28,8 @@
 #include <fstream>
 #include <memory>
 #include <set>
+
+#include <nlohmann/json.hpp>
 
 #include "dynid/store/store.hpp"
 #include "e2e_fixture.hpp"
@@ -297,6 +300,20 @@ TEST(Cluster, SigtermHandsOverAtOnceAndJoinerTakesShare) {
 
   const std::size_t joiner = cluster.start_server();
   ASSERT_TRUE(cluster.wait_until_each_holds({cluster.id(joiner)}, 20s)) << cluster.logs();
+
+  // `dynid status`: who holds which vehicle, as the database says.
+  const auto answer = run_dynid({"status", "--json"});
+  ASSERT_EQ(answer.exit_code, 0) << answer.err;
+  const auto json = nlohmann::json::parse(answer.out);
+  std::map<std::string, std::size_t> listed;
+  for (const auto& server : json.at("servers")) listed[server.at("id").get<std::string>()] = server.at("vehicles").size();
+  for (const std::size_t k : {std::size_t{0}, std::size_t{1}, joiner}) EXPECT_TRUE(listed.contains(cluster.id(k))) << answer.out;
+  EXPECT_FALSE(listed.contains(cluster.id(2))) << "the stopped server is listed\n" << answer.out;
+  const auto text = run_dynid({"status"});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("SERVER"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find(cluster.id(joiner)), std::string::npos) << text.out;
+
   cluster.drive(70s);
   ASSERT_TRUE(cluster.all_done()) << cluster.logs();
   cluster.expect_complete_and_exact();

@@ -40,6 +40,8 @@
 // - stop(): ends the renewals (idempotent; the destructor calls it). release_all() then gives
 //   every lease and the heartbeat back at once, for a server stopping after its last
 //   acknowledged write: the others take its vehicles over without waiting for the TTL.
+// - leases(): the unexpired leases (vehicles and heartbeats), read from the database now, for
+//   `dynid status`; StoreError when the database cannot be reached.
 // Thread-safe.
 #include <chrono>
 #include <condition_variable>
@@ -59,6 +61,10 @@ namespace dynid::server {
 std::string heartbeat_name(const std::string& server_id);
 /// The server id a heartbeat names, or "" when `name` is a vehicle's.
 std::string server_of_heartbeat(const std::string& name);
+
+/// Server id -> the vehicles it holds, sorted, from unexpired `leases` (LeaseKeeper::leases()):
+/// every server with a heartbeat, holding vehicles or not, and every holder of a vehicle.
+std::map<std::string, std::vector<std::string>> holdings(const std::vector<store::Lease>& leases);
 
 /// A share of `vehicles` among `servers` live servers: ceil(vehicles / servers), at least 1.
 std::size_t fair_share(std::size_t vehicles, std::size_t servers);
@@ -83,6 +89,7 @@ class LeaseKeeper {
   void release(const std::string& vehicle);
   void stop();
   void release_all();
+  std::vector<store::Lease> leases();
 
  private:
   using Clock = std::chrono::steady_clock;
