@@ -14,6 +14,7 @@ namespace dynid::server {
 namespace {
 
 constexpr std::size_t kTakePerRound = 64;
+constexpr std::size_t kMaxUnservedAnnouncements = 4096;
 
 // An id field of a sample that failed from_wire, if it is still a terminated string.
 std::optional<std::string> readable_id(const char (&field)[sizeof(dynid_wire_Id)]) {
@@ -27,6 +28,39 @@ dds::Reply reply_to(const dds::Request& request, dds::ReplyStatus status, std::s
 }
 
 }  // namespace
+
+bool Server::Impl::serves(const std::string& vehicle) {
+  if (!leases) return options.shard.owns(vehicle);
+  switch (leases->serves(vehicle)) {
+    case LeaseKeeper::Serves::held:
+      return true;
+    case LeaseKeeper::Serves::taken: {  // another server may have served it meanwhile
+      const std::size_t worker = pool.worker_of(vehicle);
+      pool.post(worker, [this, worker, vehicle] { services[worker]->forget(vehicle, false); });
+      announce_unserved(vehicle, worker);
+      return true;
+    }
+    case LeaseKeeper::Serves::other:
+      break;
+  }
+  return false;
+}
+
+void Server::Impl::keep_unserved(ingest::RunAnnouncement announcement) {
+  if (unserved_announcements.size() >= kMaxUnservedAnnouncements)
+    unserved_announcements.erase(unserved_announcements.begin());  // bounded: one goes
+  store::RunKey key{announcement.vehicle, announcement.run};
+  unserved_announcements.insert_or_assign(std::move(key), std::move(announcement));
+}
+
+// add_run is idempotent: an announcement its holder recorded already is `already_known`.
+void Server::Impl::announce_unserved(const std::string& vehicle, std::size_t worker) {
+  auto it = unserved_announcements.lower_bound({vehicle, {}});
+  while (it != unserved_announcements.end() && it->first.vehicle == vehicle) {
+    pool.post(worker, [this, worker, a = std::move(it->second)] { services[worker]->announce(a); });
+    it = unserved_announcements.erase(it);
+  }
+}
 
 void Server::Impl::dispatch_round() {
   dispatch_announcements();  // first: a run's announcement before its chunks
@@ -44,8 +78,9 @@ void Server::Impl::dispatch_announcements() {
       spdlog::warn("announcement rejected: {}", e.what());
       continue;
     }
-    if (!options.shard.owns(announcement.vehicle)) {
+    if (!serves(announcement.vehicle)) {
       counters.add(&CounterSnapshot::not_owned);
+      if (leases) keep_unserved(std::move(announcement));
       continue;
     }
     const std::size_t worker = pool.worker_of(announcement.vehicle);
@@ -67,7 +102,7 @@ void Server::Impl::dispatch_chunk(const dynid_wire_Chunk& sample) {
   }
   const auto vehicle = chunk ? std::optional(chunk->vehicle) : readable_id(sample.vehicle);
   const auto run = chunk ? std::optional(chunk->run) : readable_id(sample.run);
-  if (vehicle && !options.shard.owns(*vehicle)) {
+  if (vehicle && !serves(*vehicle)) {
     counters.add(&CounterSnapshot::not_owned);
     return;
   }
@@ -103,10 +138,12 @@ void Server::Impl::dispatch_requests() {
 }
 
 // Every server sees every request (docs/DESIGN.md, Scale-out). One naming a vehicle is its
-// owner's; a fleet is answered by the owners of its vehicles (one computes it, or each refuses
-// a fleet that spans shards); the others (vehicles, status) by every shard, the client merges.
-bool Server::Impl::concerns_this_shard(const ParsedRequest& parsed) const {
-  if (const auto vehicle = parsed.optional("vehicle")) return options.shard.owns(*vehicle);
+// server's (its shard's, or its lease holder's); a fleet is answered by the owners of its
+// vehicles (one computes it, or each refuses a fleet that spans shards; with leases every
+// server is shard 0/1 and computes it from the shared store); the others (vehicles, status) by
+// every server, the client merges.
+bool Server::Impl::concerns_this_shard(const ParsedRequest& parsed) {
+  if (const auto vehicle = parsed.optional("vehicle")) return serves(*vehicle);
   if (parsed.kind != "fleet") return true;
   const auto vehicles = split_list(parsed.required("vehicles"));
   return vehicles.empty() ||

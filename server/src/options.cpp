@@ -1,13 +1,18 @@
 #include "dynid/server/options.hpp"
 
 #include <CLI/CLI.hpp>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <thread>
 
 #include "dynid/dds/participant.hpp"
 #include "dynid/error.hpp"
+#include "dynid/input/ids.hpp"
 #include "dynid/input/option_checks.hpp"
 #include "dynid/store/location.hpp"
 
@@ -17,6 +22,8 @@ unsigned ServerOptions::worker_count() const {
   if (threads > 0) return threads;
   return std::max(1u, std::thread::hardware_concurrency());
 }
+
+bool ServerOptions::leased() const { return store::is_postgres_uri(store_path); }
 
 std::string cyclone_config_uri(const std::string& value) {
   if (value.empty()) throw InputError("--cyclone-config: empty (a configuration is required)");
@@ -45,6 +52,17 @@ CLI::Validator new_or_regular_file() {
 
 }  // namespace
 
+// Unique among the servers of one database as long as no two run on one machine with one pid
+// (an id follows the vehicle-id rule: no ':' in it).
+std::string default_server_id() {
+  char host[256] = {};
+  std::string name = gethostname(host, sizeof host - 1) == 0 ? host : "server";
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-' && c != '_') c = '-';
+  if (name.empty() || !std::isalnum(static_cast<unsigned char>(name.front()))) name = "server" + name;
+  return name.substr(0, input::kMaxIdLength - 12) + "-" + std::to_string(getpid());
+}
+
 std::optional<ServerOptions> parse_options(int argc, const char* const* argv) {
   ServerOptions o;
   std::string shard = "0/1";
@@ -67,6 +85,11 @@ std::optional<ServerOptions> parse_options(int argc, const char* const* argv) {
                  "keep the residual loop's verdict of open runs current, at most every S seconds (0: off)")
       ->check(input::within(0, kMaxLiveResidualS));
   app.add_option("--shard", shard, "own the vehicles whose hash mod N == K (K/N)");
+  app.add_option("--server-id", o.server_id, "this server's id in the leases (default <hostname>-<pid>)")
+      ->check(input::id("server id"));
+  double lease_ttl_s = 3;
+  app.add_option("--lease-ttl", lease_ttl_s, "seconds a lease lasts unrenewed (PostgreSQL store)")
+      ->check(input::within(kMinLeaseTtlS, kMaxLeaseTtlS));
   app.add_option("--reorder-window", o.store.reorder_window, "chunks stored ahead of a gap")
       ->check(input::within(1, kMaxReorderWindow));
   app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error")
@@ -80,6 +103,11 @@ std::optional<ServerOptions> parse_options(int argc, const char* const* argv) {
     throw InputError(std::string("dynid-server: ") + e.what() + " (see --help)");
   }
   o.shard = Shard::parse(shard);
+  if (o.leased() && o.shard.count != 1)
+    throw InputError("dynid-server: --shard " + shard + " with a PostgreSQL store: the servers of one "
+                     "database share its vehicles by leases, not by --shard (docs/DESIGN.md, Scale-out)");
+  if (o.server_id.empty()) o.server_id = default_server_id();
+  o.lease_ttl = std::chrono::milliseconds(std::llround(lease_ttl_s * 1000));
   o.publish_interval = std::chrono::milliseconds(publish_ms);
   o.live_residual_interval = std::chrono::seconds(live_residual_s);
   return o;

@@ -123,6 +123,8 @@ void RunService::announce(const ingest::RunAnnouncement& announcement) {
     context_.counters.add(&CounterSnapshot::rejected_announcements);
     spdlog::warn("announcement {} rejected: {}", label(key), e.what());
     publish_ack(key, find(key), {{kAnnouncementSequence, std::string("announcement rejected: ") + e.what()}});
+  } catch (const store::NotHolderError& e) {  // the new holder answers it
+    lost_lease(key.vehicle, e.what());
   }
 }
 
@@ -194,6 +196,8 @@ void RunService::submit(std::vector<PendingChunk>& chunks) {
             batch->results[i] = s.store_chunk(batch->chunks[i].chunk);
           } catch (const InputError& e) {  // rolled back alone; the others stay
             batch->results[i] = std::string(e.what());
+          } catch (const store::NotHolderError& e) {  // nothing written: the others stay
+            batch->results[i] = NotHolder{e.what()};
           }
         }
       },
@@ -246,9 +250,15 @@ bool RunService::collect_one(bool wait) {
 void RunService::apply(const InFlight& batch) {
   std::vector<store::RunKey> touched;  // runs with news, in arrival order
   std::map<store::RunKey, std::vector<const ingest::ValidatedChunk*>> stored;
+  std::map<std::string, std::string> lost;  // vehicle -> why: its lease is gone
   for (std::size_t i = 0; i < batch.chunks.size(); ++i) {
     const store::RunKey& key = batch.chunks[i].key;
     const ingest::Chunk& chunk = batch.chunks[i].chunk.chunk();
+    if (const auto* refused = std::get_if<NotHolder>(&batch.results[i])) {
+      lost.emplace(key.vehicle, refused->reason);
+      continue;
+    }
+    if (lost.contains(key.vehicle)) continue;
     RunState* run = find(key);  // loaded by receive_chunk; only its own failed load unloads it
     if (!run) continue;         // stored all the same: a later load replays it
     if (const auto* refused = std::get_if<std::string>(&batch.results[i])) {
@@ -267,6 +277,9 @@ void RunService::apply(const InFlight& batch) {
     if (is_new) stored[key].push_back(&batch.chunks[i].chunk);
     if (std::find(touched.begin(), touched.end(), key) == touched.end()) touched.push_back(key);
   }
+  // Not one chunk of a vehicle whose lease is gone is acknowledged, even one stored before the
+  // refusal in this batch: the new holder acknowledges it when the car resends it.
+  std::erase_if(touched, [&](const store::RunKey& key) { return lost.contains(key.vehicle); });
   // Durable now (the batch committed): acknowledge each run once, with its highest mark.
   for (const auto& key : touched) publish_ack(key, find(key));
   for (const auto& key : touched) fold_ready(key, *find(key), stored[key]);
@@ -274,6 +287,7 @@ void RunService::apply(const InFlight& batch) {
   // idle tick's): one fsync per batch, not two.
   for (const auto& key : touched)
     if (std::find(unsaved_.begin(), unsaved_.end(), key) == unsaved_.end()) unsaved_.push_back(key);
+  for (const auto& [vehicle, reason] : lost) lost_lease(vehicle, reason);
 }
 
 std::vector<ingest::Chunk> RunService::read_chunks(const store::RunKey& key, std::uint64_t from,
@@ -388,6 +402,9 @@ void RunService::write_folds(store::Store& s, const std::vector<SavedFold>& fold
       } catch (const InputError& e) {
         spdlog::error("run {}: checkpoint through #{} not saved: {}", label(fold.key),
                       checkpoint.through, e.what());
+      } catch (const store::NotHolderError& e) {  // the new holder replays from its own
+        spdlog::warn("run {}: checkpoint through #{} not saved: {}", label(fold.key),
+                     checkpoint.through, e.what());
       }
     }
     if (!fold.mark) continue;
@@ -395,6 +412,8 @@ void RunService::write_folds(store::Store& s, const std::vector<SavedFold>& fold
       s.mark_folded(fold.key, *fold.mark);
     } catch (const InputError& e) {
       spdlog::error("run {}: folded mark #{} not saved: {}", label(fold.key), *fold.mark, e.what());
+    } catch (const store::NotHolderError& e) {
+      spdlog::warn("run {}: folded mark #{} not saved: {}", label(fold.key), *fold.mark, e.what());
     }
   }
 }
@@ -551,6 +570,35 @@ void RunService::publish_pending(const std::string& vehicle) {
       spdlog::error("run {}: estimates not published: {}", label(key), e.what());
     }
   }
+}
+
+void RunService::forget(const std::string& vehicle, bool save) {
+  flush_pending();
+  drop(vehicle, save);
+}
+
+// Without flushing: also called while a committed batch is applied (lost_lease), where the
+// batches behind it must still be applied in order by the collect() under way.
+void RunService::drop(const std::string& vehicle, bool save) {
+  std::vector<store::RunKey> keys;
+  for (const auto& [key, run] : runs_)
+    if (key.vehicle == vehicle) keys.push_back(key);
+  const auto unsaved = std::stable_partition(unsaved_.begin(), unsaved_.end(),
+                                      [&](const store::RunKey& key) { return key.vehicle != vehicle; });
+  if (save && unsaved != unsaved_.end()) save_folds(std::vector<store::RunKey>(unsaved, unsaved_.end()));
+  unsaved_.erase(unsaved, unsaved_.end());
+  for (const auto& key : keys) {
+    runs_.erase(key);
+    dirty_.erase(key);
+    residual_stale_.erase(key);
+  }
+  if (!keys.empty()) spdlog::info("vehicle {}: {} runs dropped from memory", input::printable(vehicle), keys.size());
+}
+
+void RunService::lost_lease(const std::string& vehicle, const std::string& reason) {
+  spdlog::warn("vehicle {}: lease lost, nothing more acknowledged: {}", input::printable(vehicle), reason);
+  drop(vehicle, false);  // its chunks still queued or at the committer are refused the same way
+  if (lease_lost_) lease_lost_(vehicle);
 }
 
 void RunService::settle() {

@@ -30,10 +30,19 @@ std::chrono::milliseconds tick_period(const ServerOptions& options) {
                     std::chrono::milliseconds(100));
 }
 
+// With a shared store, the server's id and the fence: its store refuses every write of a
+// vehicle whose lease it does not hold (store.hpp, Leases).
+ServerOptions with_holder(ServerOptions options) {
+  if (!options.leased()) return options;
+  if (options.server_id.empty()) options.server_id = default_server_id();
+  options.store.holder = options.server_id;
+  return options;
+}
+
 }  // namespace
 
 Server::Impl::Impl(ServerOptions opts)
-    : options(std::move(opts)),
+    : options(with_holder(std::move(opts))),
       store(options.store_path, options.store),
       participant({options.domain, cyclone_config_uri(options.cyclone_config)}),
       announcements(participant, {dds::kAllVehiclesPartition}),
@@ -48,7 +57,7 @@ Server::Impl::Impl(ServerOptions opts)
       waitset(dds::check(dds_create_waitset(participant.handle()), "dds_create_waitset")),
       stop_guard(dds::check(dds_create_guardcondition(participant.handle()),
                             "dds_create_guardcondition")) {
-  refuse_foreign_vehicles();
+  if (!options.leased()) refuse_foreign_vehicles();  // shared: every server sees every vehicle
   for (const dds_entity_t reader : {announcements.handle(), chunks.handle(), requests.handle()}) {
     conditions.emplace_back(dds::check(dds_create_readcondition(reader, DDS_ANY_STATE),
                                        "dds_create_readcondition"));
@@ -59,13 +68,36 @@ Server::Impl::Impl(ServerOptions opts)
     services[k]->set_waker([this, k] {
       pool.post_unbounded(k, [this, k] { services[k]->collect_committed(); });
     });
+  if (options.leased()) {
+    start_leases();  // a vehicle's runs are loaded when its lease is taken
+    spdlog::info("dynid-server {}: store {} (shared, leases of {} ms), domain {}, {} workers, "
+                 "checkpoint every {}",
+                 options.server_id, store::for_messages(options.store_path), options.lease_ttl.count(),
+                 options.domain, pool.size(), options.checkpoint_every);
+    return;
+  }
   resume_open_runs();
   spdlog::info("dynid-server: store {}, domain {}, {} workers, shard {}, checkpoint every {}",
                store::for_messages(options.store_path), options.domain, pool.size(), options.shard.to_string(),
                options.checkpoint_every);
 }
 
+void Server::Impl::start_leases() {
+  for (auto& service : services)
+    service->set_lease_lost([this](const std::string& vehicle) { leases->forget(vehicle); });
+  leases = std::make_unique<LeaseKeeper>(
+      options.store_path, options.store, options.server_id, options.lease_ttl,
+      [this](const std::string& vehicle, bool shed) {
+        const std::size_t worker = pool.worker_of(vehicle);
+        pool.post_unbounded(worker, [this, worker, vehicle, shed] {
+          services[worker]->forget(vehicle, shed);
+          if (shed) leases->release(vehicle);  // after its last acknowledged write
+        });
+      });
+}
+
 Server::Impl::~Impl() {
+  if (leases) leases->stop();  // no lease changes hands while the workers finish
   pool.stop();  // finish what is queued while the services and writers still exist
   for (auto& service : services) {  // and what is at the committer (acks, folds, marks)
     try {
@@ -75,6 +107,9 @@ Server::Impl::~Impl() {
     }
   }
   committer.stop();  // nothing calls back into the pool or the services after this
+  // Every acknowledged write is durable: the others may take the vehicles over now, not a TTL
+  // later.
+  if (leases) leases->release_all();
   spdlog::info("dynid-server stopped; counters {}", counters.snapshot().to_json());
 }
 
@@ -136,8 +171,25 @@ CounterSnapshot Server::counters() const { return impl_->counters.snapshot(); }
 
 // ---- requests ----------------------------------------------------------------------------
 
+// The counters, and with leases which server this is and who holds which vehicle:
+// {..counters.., "server": id, "servers": [{"id": id, "vehicles": [..]}, ..]}.
+std::string Server::Impl::status_reply() {
+  std::string out = counters.snapshot().to_json();
+  if (!leases) return out;
+  out.pop_back();  // the counters' closing brace
+  out += ",\"server\":" + report::json_string(options.server_id) + ",\"servers\":[";
+  bool first_server = true;
+  for (const auto& [server, vehicles] : holdings(leases->leases())) {
+    out += std::string(first_server ? "" : ",") + "{\"id\":" + report::json_string(server) + ",\"vehicles\":[";
+    for (std::size_t k = 0; k < vehicles.size(); ++k) out += (k ? "," : "") + report::json_string(vehicles[k]);
+    out += "]}";
+    first_server = false;
+  }
+  return out + "]}";
+}
+
 std::string Server::Impl::fleet_reply(const ParsedRequest& request) {
-  if (request.kind == "status") return counters.snapshot().to_json();
+  if (request.kind == "status") return status_reply();
   auto vehicles = store.with([](store::Store& s) { return s.list_vehicles(); });
   std::string out;
   for (const auto& v : vehicles)

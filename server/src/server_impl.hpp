@@ -10,6 +10,7 @@
 #include "dynid.h"
 #include "dynid/dds/reader.hpp"
 #include "dynid/dds/request.hpp"
+#include "dynid/server/lease_keeper.hpp"
 #include "dynid/server/request_parser.hpp"
 #include "dynid/server/run_service.hpp"
 #include "dynid/server/server.hpp"
@@ -38,6 +39,14 @@ struct Server::Impl {
 
   /// InputError when the store holds vehicles this shard does not own.
   void refuse_foreign_vehicles();
+  /// With a shared store: the lease keeper, and what a lost or given-back lease does.
+  void start_leases();
+  /// Whether this server serves `vehicle` now: its shard's, or (shared store) its lease's. A
+  /// lease just taken first has the vehicle's worker drop what it kept of it (lease_keeper.hpp).
+  bool serves(const std::string& vehicle);
+  void keep_unserved(ingest::RunAnnouncement announcement);
+  /// The announcements kept for `vehicle`, to its worker (a lease just taken).
+  void announce_unserved(const std::string& vehicle, std::size_t worker);
   void resume_open_runs();
   void dispatch_round();
   void dispatch_announcements();
@@ -45,7 +54,7 @@ struct Server::Impl {
   void dispatch_requests();
   void dispatch_chunk(const dynid_wire_Chunk& sample);
   /// Whether this server answers `parsed` (the routing of requests between shards).
-  bool concerns_this_shard(const ParsedRequest& parsed) const;
+  bool concerns_this_shard(const ParsedRequest& parsed);
   void accept_request(const dds::Request& request);
   dds::Reply execute(const ParsedRequest& request, RunService& service);
   /// Runs `work` and replies with its result, or with the status its exception maps to
@@ -57,6 +66,7 @@ struct Server::Impl {
   void dispatch_fleet(const ParsedRequest& request, const dds::Request& raw,
                       const ReplyCache::Key& key);
   std::string fleet_reply(const ParsedRequest& request);
+  std::string status_reply();
   /// Writes `reply` stamped with this server's shard.
   void send(dds::Reply reply);
 
@@ -79,6 +89,10 @@ struct Server::Impl {
   dds::Entity stop_guard;
   std::vector<dds::Entity> conditions;
   std::atomic<bool> stopping{false};
+  std::unique_ptr<LeaseKeeper> leases;  // shared store only; after the pool it posts to
+  // Announcements of vehicles another server held (shared store; dispatcher thread only): a
+  // car announces a run once, so whoever takes the vehicle later must still record it.
+  std::map<store::RunKey, ingest::RunAnnouncement> unserved_announcements;
 };
 
 }  // namespace dynid::server

@@ -70,6 +70,11 @@ std::string loopback_config() {
   return file + ",<Discovery><Tag>" + process_tag() + "</Tag></Discovery>";
 }
 
+std::string server_config() {
+  return loopback_config() + "," +
+         dds::config_file_uri(std::string(DYNID_SOURCE_DIR) + "/deploy/cyclonedds/server-lease.xml");
+}
+
 dds_domainid_t domain() { return open_domain.value_or(kDomain); }
 
 void use_open_network(dds_domainid_t domain_id) { open_domain = domain_id; }
@@ -217,6 +222,16 @@ void TestCar::send_raw(const dynid_wire_Chunk& sample) {
   chunks_.wait_for_readers(1, kPatience);
   for (int attempt = 0; attempt < 50 && !chunks_.write(sample); ++attempt) {
   }  // a full reader blocks the writer for max_blocking_time; retry as the car's spool would
+}
+
+std::vector<dds::ChunkReceipt> TestCar::take_receipts() {
+  std::vector<dds::ChunkReceipt> taken;
+  for (auto& sample : acks_.take()) {
+    taken.push_back(dds::from_wire(sample.data));
+    EXPECT_EQ(taken.back().vehicle, vehicle_) << "an acknowledgement of another vehicle";
+    latest_[taken.back().run] = taken.back();
+  }
+  return taken;
 }
 
 std::optional<dds::ChunkReceipt> TestCar::wait_receipt(

@@ -51,6 +51,10 @@ std::string loopback_config();
 /// The domain of this process's participants, the server's and the CLI's: kDomain unless
 /// use_open_network() chose another.
 dds_domainid_t domain();
+/// loopback_config() plus deploy/cyclonedds/server-lease.xml, for servers of a scale-out: after a
+/// SIGKILL, the cars' chunk writers wait for the dead server's reader until its DDS lease (2 s
+/// there) expires.
+std::string server_config();
 /// tests/interop: everything on `domain_id` with loopback.xml and no discovery tag, since a
 /// participant of another DDS implementation carries no Cyclone tag and a tagged participant
 /// ignores it. The domain id of its own then isolates the test. Call before participant().
@@ -106,6 +110,8 @@ class TestCar {
   std::optional<dds::ChunkReceipt> wait_receipt(const std::string& run,
                                                 const std::function<bool(const dds::ChunkReceipt&)>& done,
                                                 std::chrono::milliseconds patience = kPatience);
+  /// The receipts that arrived since the last call, in arrival order, without waiting.
+  std::vector<dds::ChunkReceipt> take_receipts();
   /// Waits until every sequence up to `last` is acknowledged.
   bool wait_acked(const std::string& run, std::int64_t last,
                   std::chrono::milliseconds patience = kPatience);

@@ -125,6 +125,20 @@ TEST(StatusText, OneCounterPerLineWithWhatItCounts) {
   EXPECT_NE(partial.find("shard 0/2: did not answer"), std::string::npos) << partial;
 }
 
+// Issue 20: servers sharing one PostgreSQL store answer as shard 0/1 with who holds what; the
+// text is the counters, then one line per server: its id, how many vehicles, which.
+TEST(StatusText, ServersOfASharedStoreAsATable) {
+  cli::ShardReplies one;
+  one.add(status_reply(0, 1, R"({"chunks_stored":40,"server":"b-2","servers":[)"
+                             R"({"id":"a-1","vehicles":["car-1","car-3"]},{"id":"b-2","vehicles":[]}]})"));
+  const std::string text = cli::status_text(one);
+  EXPECT_EQ(text.find('{'), std::string::npos) << text;
+  EXPECT_NE(text.find("chunks stored durably (acknowledged)"), std::string::npos) << text;
+  EXPECT_NE(text.find("answered by b-2\nSERVER  VEHICLES\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("\na-1     2 car-1 car-3\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("\nb-2     0\n"), std::string::npos) << text;
+}
+
 // Issue 16 item 4: per model what the run identifies and what it cannot with the signal to move;
 // then each manoeuvre once, with every parameter of every model it would bring.
 TEST(ExcitationReport, GroupsWhatTheRunCannotIdentifyByTheManoeuvreThatWould) {

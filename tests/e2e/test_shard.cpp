@@ -95,13 +95,6 @@ std::string read_text(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-// The servers advertise a 2 s lease (deploy/cyclonedds/server-lease.xml): after the SIGKILL,
-// the cars' chunk writers wait for the dead server's reader until its lease expires.
-std::string server_config() {
-  return loopback_config() + "," +
-         dds::config_file_uri(std::string(DYNID_SOURCE_DIR) + "/deploy/cyclonedds/server-lease.xml");
-}
-
 class ShardServer {
  public:
   ShardServer(const TempDir& dir, std::uint32_t index) : dir_(dir), index_(index) { start(); }

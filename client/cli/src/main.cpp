@@ -267,7 +267,9 @@ int main(int argc, char** argv) {
   auto* close_cmd = app.add_subcommand("close", "close a run (final estimates)");
   close_cmd->add_option("--vehicle", vehicle)->required();
   close_cmd->add_option("--run", run)->required();
-  auto* status_cmd = app.add_subcommand("status", "the server's counters, one per line with what it counts (--json: raw)");
+  auto* status_cmd = app.add_subcommand(
+      "status", "the server's counters, one per line with what it counts; with servers sharing one "
+                "PostgreSQL store, which server holds which vehicles (--json: raw)");
   std::vector<std::string> shared;
   std::string fleet_vehicles;
   auto* fleet_cmd = app.add_subcommand(

@@ -101,13 +101,14 @@ constexpr std::pair<const char*, const char*> kCounterMeaning[] = {
     {"estimates_published", "estimates published"},
     {"requests", "engineer requests received"},
     {"requests_rejected", "engineer requests refused"},
-    {"not_owned", "samples of other shards' vehicles"},
+    {"not_owned", "samples of vehicles served elsewhere"},
     {"store_errors", "store errors"},
 };
 
 std::string counter_lines(const ordered_json& counters, const std::string& indent) {
   std::string out;
   for (const auto& [key, value] : counters.items()) {
+    if (key == "server" || key == "servers") continue;  // server_lines()
     std::string label = key;
     for (const auto& [name, meaning] : kCounterMeaning)
       if (key == name) label = meaning;
@@ -117,11 +118,31 @@ std::string counter_lines(const ordered_json& counters, const std::string& inden
   return out;
 }
 
+// With a shared store (leases): which server answered, then a column per server id, the number
+// of vehicles it holds and their ids.
+std::string server_lines(const ordered_json& status) {
+  if (!status.contains("servers") || !status["servers"].is_array()) return {};
+  std::string out = "\nanswered by " + status.value("server", std::string("?")) + "\n";
+  std::size_t width = 6;
+  for (const auto& server : status["servers"]) width = std::max(width, server.value("id", std::string()).size());
+  const auto pad = [&](const std::string& text) { return text + std::string(width + 2 - text.size(), ' '); };
+  out += pad("SERVER") + "VEHICLES\n";
+  for (const auto& server : status["servers"]) {
+    const auto vehicles = server.value("vehicles", ordered_json::array());
+    std::string list;
+    for (const auto& v : vehicles) list += " " + (v.is_string() ? v.get<std::string>() : v.dump());
+    out += pad(server.value("id", std::string("?"))) + std::to_string(vehicles.size()) + list + "\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string status_text(const ShardReplies& replies) {
-  if (replies.count() == 1 && replies.complete())
-    return counter_lines(parse_payload(replies.replies().begin()->second, "status"), "");
+  if (replies.count() == 1 && replies.complete()) {
+    const auto status = parse_payload(replies.replies().begin()->second, "status");
+    return counter_lines(status, "") + server_lines(status);
+  }
   std::string out;
   for (const auto& [index, reply] : replies.replies())
     out += "shard " + name_of(reply) + "\n" + counter_lines(parse_payload(reply, "status"), "  ");

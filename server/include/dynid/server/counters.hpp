@@ -23,7 +23,7 @@ struct CounterSnapshot {
   std::uint64_t estimates_published = 0;
   std::uint64_t requests = 0;
   std::uint64_t requests_rejected = 0;       ///< bad request or not found
-  std::uint64_t not_owned = 0;               ///< samples of vehicles of other shards, ignored
+  std::uint64_t not_owned = 0;               ///< samples of vehicles of other shards (or leased elsewhere), ignored
   std::uint64_t store_errors = 0;            ///< storage failures (nothing acknowledged)
 
   std::string to_json() const;

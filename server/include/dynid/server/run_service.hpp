@@ -37,6 +37,11 @@
 // and the run is not kept part way: every request on it fails the same way until the store is
 // restored, rather than serving a partial run as if it were complete.
 //
+// Leases (several servers on one PostgreSQL store, lease_keeper.hpp): the store is fenced by
+// this server's id, so a write of a vehicle whose lease was lost is refused (NotHolderError).
+// Its chunks are then not acknowledged (the car resends them to the new holder), its marks and
+// checkpoints not saved, and its runs dropped from memory (forget).
+//
 // Should a stored chunk be refused by the processor (a model rejects its rows), the run stops
 // folding ("halted", with the reason, logged and in the ack); its chunks stay in the store for
 // a reprocess.
@@ -121,6 +126,18 @@ class RunService {
   /// flush_pending(), then saves the folded marks and checkpoints still unsaved: the store's
   /// ledger is then up to date (before a request reads it, and on every tick).
   void settle();
+  /// Drops every run of `vehicle` from memory, after flush_pending() (its chunks received so far
+  /// are stored or refused, and acknowledged if stored); with `save`, after saving its unsaved
+  /// folded marks and checkpoints too. For a vehicle whose lease this server gives back (save)
+  /// or lost (not: its writes fail), and before serving one whose lease it just took: the runs
+  /// are then loaded from the store again (lease_keeper.hpp).
+  void forget(const std::string& vehicle, bool save);
+  /// How a write refused for a lost lease (store::NotHolderError) is reported: the vehicle's
+  /// chunks of that batch are not acknowledged, its runs are dropped (forget), and `lost`
+  /// (the server: LeaseKeeper::forget) is told. Set before the first chunk.
+  void set_lease_lost(std::function<void(const std::string& vehicle)> lost) {
+    lease_lost_ = std::move(lost);
+  }
 
   // Run-level requests. InputError/NotFound name what is wrong.
   EstimateTables estimate(const std::string& vehicle, const std::optional<std::string>& run,
@@ -181,11 +198,15 @@ class RunService {
     std::vector<UnsavedCheckpoint> checkpoints;
     std::optional<std::uint64_t> mark;
   };
+  /// A chunk's write refused because this server no longer holds its vehicle's lease.
+  struct NotHolder {
+    std::string reason;
+  };
   /// A batch at the committer: written there, read by the worker only once `done`.
   struct InFlight {
     std::vector<PendingChunk> chunks;
     std::vector<SavedFold> folds;
-    std::vector<std::variant<store::StoreChunkResult, std::string>> results;
+    std::vector<std::variant<store::StoreChunkResult, std::string, NotHolder>> results;
     std::mutex mutex;
     std::condition_variable finished;
     bool done = false;
@@ -256,6 +277,11 @@ class RunService {
   std::vector<PendingChunk> pending_;  // received, validated, not yet at the committer
   std::deque<std::shared_ptr<InFlight>> in_flight_;  // at the committer, oldest first
   std::function<void()> wake_;
+  std::function<void(const std::string&)> lease_lost_;
+  /// The vehicle's lease is lost (a write said NotHolderError): forget it, tell lease_lost_.
+  void lost_lease(const std::string& vehicle, const std::string& reason);
+  /// forget() without the flush.
+  void drop(const std::string& vehicle, bool save);
   std::uint64_t changes_ = 0;          // RunState::changed counter
   std::set<store::RunKey> dirty_;      // runs whose estimates changed since their publication
   // The live residual verdict (--live-residual): runs whose verdict is older than their chunks,

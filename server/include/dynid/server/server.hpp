@@ -16,9 +16,18 @@
 //   never Cyclone's default), starts the workers and queues the resumption of every open run
 //   of this shard. StoreError/CorruptionError/DdsError/InputError on failure; InputError too
 //   when the store holds vehicles another shard owns (shard.hpp).
-// - Several servers (options.shard K/N): samples of vehicles of other shards are dropped;
-//   requests naming a vehicle are answered by its owner only, vehicles/status by every
-//   shard, and every reply carries the shard (docs/DESIGN.md, "Scale-out").
+// - Several servers on SQLite stores (options.shard K/N): samples of vehicles of other shards
+//   are dropped; requests naming a vehicle are answered by its owner only, vehicles/status by
+//   every shard, and every reply carries the shard (docs/DESIGN.md, "Scale-out").
+// - Several servers on one PostgreSQL store (options.leased()): a vehicle is served by the
+//   holder of its lease (lease_keeper.hpp); the store is fenced by options.server_id, so a
+//   server writes nothing of a vehicle it does not hold. Samples and requests of a vehicle held
+//   elsewhere are dropped (the holder answers); one whose lease is free is taken when the fair
+//   share allows, and its runs are loaded from the store (checkpoint + the chunks after it)
+//   before anything new is folded. No run is resumed at start: a vehicle's runs are loaded
+//   when its lease is taken. Requests naming no vehicle are answered by every server, as shard
+//   0/1 (the client keeps the first: the store is the same). Stopping (the destructor) releases
+//   every lease after the last acknowledged write.
 // - run() dispatches until stop(); stop() may be called from any thread (not from a signal
 //   handler: main.cpp waits for signals with sigwait). After run() returns, the destructor
 //   lets the workers finish what is queued.

@@ -59,7 +59,10 @@ std::string render_vehicles(const std::vector<std::string>& vehicles, bool json)
 std::string merged_status(const ShardReplies& replies);
 /// `dynid status` for people: per shard (a heading when there are several) one line per
 /// counter, with what it counts ("chunks stored durably ... 40"), and a line per shard that did
-/// not answer. Counters this client does not know are printed by their JSON name.
+/// not answer. Counters this client does not know are printed by their JSON name. Servers on
+/// one PostgreSQL store (leases) answer as shard 0/1 with "server" (its id) and "servers"
+/// ([{"id", "vehicles"}]: who holds which vehicle): then a table follows the counters, one
+/// line per server: its id, how many vehicles it holds, and which.
 std::string status_text(const ShardReplies& replies);
 /// E.g. "shard 1/2 did not answer within 10000 ms: its vehicles are not included" (`what`:
 /// "vehicles"). Empty when nothing is missing.
