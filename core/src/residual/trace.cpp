@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <boost/math/distributions/normal.hpp>
+
 #include "dynid/error.hpp"
 
 namespace dynid::residual {
@@ -42,6 +44,33 @@ std::vector<std::string> Trace::added() const {
   return out;
 }
 
+std::string better_sensor_refusal(const EffectComparison& c) {
+  std::size_t declared = 0;
+  for (const ParameterChange& p : c.parameters) declared += std::isfinite(p.before) && std::isfinite(p.after) ? 1 : 0;
+  if (declared == 0) return {};
+  constexpr double kFamilyErrorRate = 0.01;
+  const double z = boost::math::quantile(boost::math::complement(
+      boost::math::normal(), kFamilyErrorRate / (2.0 * static_cast<double>(declared))));
+  const ParameterChange* worst = nullptr;
+  double worst_moved = 0.0;
+  for (const ParameterChange& p : c.parameters) {
+    if (!std::isfinite(p.before) || !std::isfinite(p.after)) continue;
+    // A sensor that does not sharpen a parameter: its difference's variance is taken as the sum
+    // (conservative), Hausman's difference being undefined there.
+    const double variance = p.std_before > p.std_after ? p.std_before * p.std_before - p.std_after * p.std_after
+                                                       : p.std_before * p.std_before + p.std_after * p.std_after;
+    if (!(variance > 0.0)) continue;
+    const double moved = std::abs(p.after - p.before) / std::sqrt(variance);
+    if (moved > worst_moved) worst = &p, worst_moved = moved;
+  }
+  if (worst == nullptr || !(worst_moved > z)) return {};
+  return c.effect + " refused: as a better sensor of a declared signal (at the declared floor) it should "
+                    "sharpen the parameters, not move them, but it takes " + worst->name + " from " +
+         four_digits(worst->before) + " to " + four_digits(worst->after) + " " + worst->unit + ", " +
+         four_digits(worst_moved) + " std of the difference (Hausman, at most " + four_digits(z) + " at 1 % over " +
+         std::to_string(declared) + " parameters): it differs from that signal systematically, not only in noise";
+}
+
 Trace trace(const model::Model& model, const std::vector<std::string>& declared,
             const ingest::RecordedRun& run, const TraceOptions& options) {
   if (options.max_rounds < 0) throw InputError("trace: max_rounds " + std::to_string(options.max_rounds) + " < 0");
@@ -70,7 +99,9 @@ Trace trace(const model::Model& model, const std::vector<std::string>& declared,
     }
     EffectComparison c = compare_effect(model, effects, r.diagnosis.accepted->effect, segments, rate, odmf,
                                         options.diagnosis.screen.fit, options.reference);
-    if (const std::string why = refusal(c); !why.empty()) {
+    std::string why = refusal(c);
+    if (why.empty() && r.diagnosis.masked) why = better_sensor_refusal(c);
+    if (!why.empty()) {
       t.stopped = why + (r.diagnosis.implausible.empty() ? "" : "; the model as it stands is implausible on this run");
       t.rounds.push_back(std::move(r));
       return t;
