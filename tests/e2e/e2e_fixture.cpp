@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "child_process.hpp"
 #include "dynid/dds/conversions.hpp"
 #include "dynid/dds/topics.hpp"
 
@@ -21,13 +22,6 @@ std::string process_tag() {
       "dynid-e2e-" + std::to_string(getpid()) + "-" +
       std::to_string(std::chrono::steady_clock::now().time_since_epoch().count());
   return tag;
-}
-
-std::vector<char*> c_argv(std::vector<std::string>& argv) {
-  std::vector<char*> out;
-  for (auto& a : argv) out.push_back(a.data());
-  out.push_back(nullptr);
-  return out;
 }
 
 bool same(double a, double b, double relative) {
@@ -109,15 +103,7 @@ InProcessServer::~InProcessServer() {
 ServerProcess::ServerProcess(const std::vector<std::string>& arguments, const std::string& log) {
   std::vector<std::string> argv{DYNID_SERVER_EXE};
   argv.insert(argv.end(), arguments.begin(), arguments.end());
-  pid_ = fork();
-  if (pid_ == 0) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    execv(argv[0].c_str(), c_argv(argv).data());
-    _exit(127);
-  }
-  if (pid_ < 0) throw std::runtime_error("fork failed");
+  pid_ = test::spawn_child(argv, {.file = log});
 }
 
 ServerProcess::~ServerProcess() {
@@ -155,17 +141,18 @@ CommandResult run_dynid(const std::vector<std::string>& arguments, int timeout_s
 
 CommandResult run_command(const std::vector<std::string>& arguments,
                           std::chrono::milliseconds timeout) {
+  // Close-on-exec: a child started meanwhile by another thread must not hold these pipes open.
   int out[2], err[2];
-  if (pipe(out) != 0 || pipe(err) != 0) throw std::runtime_error("pipe failed");
-  std::vector<std::string> argv = arguments;
-  const pid_t pid = fork();
-  if (pid == 0) {
-    dup2(out[1], 1);
-    dup2(err[1], 2);
-    close(out[0]);
-    close(err[0]);
-    execv(argv[0].c_str(), c_argv(argv).data());
-    _exit(127);
+  if (pipe2(out, O_CLOEXEC) != 0 || pipe2(err, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  test::ChildOutput to_pipes;
+  to_pipes.stdout_fd = out[1];
+  to_pipes.stderr_fd = err[1];
+  pid_t pid = -1;
+  try {
+    pid = test::spawn_child(arguments, to_pipes);
+  } catch (...) {
+    for (const int fd : {out[0], out[1], err[0], err[1]}) close(fd);
+    throw;
   }
   close(out[1]);
   close(err[1]);

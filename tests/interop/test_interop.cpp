@@ -19,6 +19,7 @@
 #include <span>
 #include <sstream>
 
+#include "child_process.hpp"
 #include "dynid/dds/conversions.hpp"
 #include "e2e_fixture.hpp"
 
@@ -50,17 +51,7 @@ CommandResult peer(const std::vector<std::string>& arguments) {
 class BackgroundPeer {
  public:
   BackgroundPeer(const std::vector<std::string>& arguments, const std::string& out) {
-    std::vector<std::string> argv = peer_argv(arguments);
-    std::vector<char*> c_argv;
-    for (auto& a : argv) c_argv.push_back(a.data());
-    c_argv.push_back(nullptr);
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int fd = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(fd, 1);
-      execv(c_argv[0], c_argv.data());
-      _exit(127);
-    }
+    pid_ = test::spawn_child(peer_argv(arguments), {.file = out, .append = false, .stderr_to_file = false});
   }
   ~BackgroundPeer() {
     kill(pid_, SIGTERM);

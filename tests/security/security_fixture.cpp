@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "child_process.hpp"
 #include "dynid/store/store.hpp"
 
 namespace dynid::security_test {
@@ -29,20 +30,7 @@ std::string with_tag(const std::string& uri) {
 
 // fork + exec with stdout and stderr into `log` (appended).
 pid_t spawn(const std::vector<std::string>& argv, const std::filesystem::path& log) {
-  std::vector<std::string> copy = argv;
-  std::vector<char*> c_argv;
-  for (auto& a : copy) c_argv.push_back(a.data());
-  c_argv.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    execv(c_argv[0], c_argv.data());
-    _exit(127);
-  }
-  if (pid < 0) throw std::runtime_error("fork failed");
-  return pid;
+  return test::spawn_child(argv, {.file = log.string()});
 }
 
 // The wait status, or -1 if `pid` did not end by the deadline (then it is killed and reaped).

@@ -1,5 +1,7 @@
 #include "postgres_cluster.hpp"
 
+#include "child_process.hpp"
+
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <libpq-fe.h>
@@ -35,20 +37,7 @@ bool running_as_root() {
 int run(std::vector<std::string> argv, const std::string& log) {
   if (running_as_root())
     argv.insert(argv.begin(), {"/usr/sbin/runuser", "-u", kUnprivileged, "--"});
-  const pid_t child = fork();
-  if (child < 0) throw std::runtime_error("fork failed");
-  if (child == 0) {
-    const int out = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    if (out >= 0) {
-      dup2(out, STDOUT_FILENO);
-      dup2(out, STDERR_FILENO);
-    }
-    std::vector<char*> args;
-    for (auto& arg : argv) args.push_back(arg.data());
-    args.push_back(nullptr);
-    execvp(args[0], args.data());
-    _exit(127);
-  }
+  const pid_t child = dynid::test::spawn_child(argv, {.file = log}, /*search_path=*/true);
   int status = 0;
   waitpid(child, &status, 0);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
