@@ -36,7 +36,7 @@ bool Server::Impl::serves(const std::string& vehicle) {
       return true;
     case LeaseKeeper::Serves::taken: {  // another server may have served it meanwhile
       const std::size_t worker = pool.worker_of(vehicle);
-      pool.post(worker, [this, worker, vehicle] { services[worker]->forget(vehicle, false); });
+      pool.post(worker, [this, worker, vehicle] { services[worker]->take_over(vehicle); });
       announce_unserved(vehicle, worker);
       return true;
     }

@@ -577,6 +577,17 @@ void RunService::forget(const std::string& vehicle, bool save) {
   drop(vehicle, save);
 }
 
+void RunService::take_over(const std::string& vehicle) {
+  forget(vehicle, false);
+  try {
+    context_.store.with([&](store::Store& s) { s.restart_folds(vehicle); });
+  } catch (const store::NotHolderError& e) {
+    lost_lease(vehicle, e.what());
+  } catch (const std::exception& e) {  // the marks only lag: the folds restart from checkpoints
+    spdlog::error("vehicle {}: folded marks not set back: {}", input::printable(vehicle), e.what());
+  }
+}
+
 // Without flushing: also called while a committed batch is applied (lost_lease), where the
 // batches behind it must still be applied in order by the collect() under way.
 void RunService::drop(const std::string& vehicle, bool save) {

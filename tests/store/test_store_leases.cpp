@@ -84,5 +84,31 @@ TEST_P(StoreLeases, AReleasedLeaseIsTakenAtOnceAndOnlyItsHolderReleasesIt) {
   EXPECT_THROW(first.acquire_lease("proto-17", "server-a", 0ms), InputError);
 }
 
+// Folds live in their server's memory: a server that opens a shared store leaves the others'
+// folded marks alone, and the one that takes a vehicle over sets that vehicle's marks back to
+// its checkpoints (it folds again from there), and no other vehicle's.
+TEST_P(StoreLeases, ATakeoverSetsOnlyItsVehiclesFoldedMarksBackToTheirCheckpoints) {
+  Store first = open(held_by("server-a"));
+  for (const char* vehicle : {"proto-17", "proto-18"}) {
+    first.acquire_lease(vehicle, "server-a", 60s);
+    first.add_run(announcement(vehicle, "run-1"));
+    for (std::uint64_t s = 0; s < 6; ++s) first.store_chunk(chunk(vehicle, "run-1", s));
+    first.save_checkpoint({vehicle, "run-1"}, 2, "checkpoint");
+    first.mark_folded({vehicle, "run-1"}, 5);
+  }
+  Store second = open(held_by("server-b"));
+  EXPECT_EQ(second.folded_through({"proto-17", "run-1"}), 5u);  // opening changed nothing
+  EXPECT_THROW(second.restart_folds("proto-17"), NotHolderError);  // not its vehicle yet
+
+  first.release_lease("proto-17", "server-a");
+  ASSERT_EQ(second.acquire_lease("proto-17", "server-b", 60s).holder, "server-b");
+  second.restart_folds("proto-17");
+  EXPECT_EQ(second.folded_through({"proto-17", "run-1"}), 2u);
+  second.mark_folded({"proto-17", "run-1"}, 3);  // the new holder's replay moves it forward
+  EXPECT_EQ(second.folded_through({"proto-18", "run-1"}), 5u);  // the other vehicle's stays
+  second.acquire_lease("never-seen", "server-b", 60s);
+  EXPECT_NO_THROW(second.restart_folds("never-seen"));  // no runs: nothing to do
+}
+
 }  // namespace
 }  // namespace dynid::store::test

@@ -128,6 +128,9 @@ class Backend {
   virtual std::int64_t contiguous_from(std::int64_t run_id, std::int64_t from) = 0;
   virtual void set_contiguous(std::int64_t run_id, std::int64_t mark) = 0;
   virtual void set_folded(std::int64_t run_id, std::int64_t mark) = 0;
+  /// Every run's folded mark back to its newest checkpoint (-1 without one): the vehicle's runs,
+  /// or every run when vehicle_id is nullopt.
+  virtual void restart_folds(std::optional<std::int64_t> vehicle_id) = 0;
   virtual std::unique_ptr<ChunkRows> chunk_rows(std::int64_t run_id, std::int64_t from,
                                                 std::int64_t to) = 0;
 

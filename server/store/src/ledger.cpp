@@ -127,6 +127,13 @@ void Store::mark_folded(const RunKey& key, std::uint64_t sequence) {
   transaction->commit();
 }
 
+void Store::restart_folds(const std::string& vehicle) {
+  Impl& s = *impl_;
+  const auto transaction = s.begin_write(vehicle);
+  if (const auto id = s.backend->find_vehicle(vehicle)) s.backend->restart_folds(*id);
+  transaction->commit();
+}
+
 void Store::save_checkpoint(const RunKey& key, std::uint64_t folded, std::string_view state) {
   Impl& s = *impl_;
   const std::int64_t run_id = s.run(key).id;

@@ -89,10 +89,11 @@ constexpr const char* kDropLease = "DELETE FROM leases WHERE vehicle = $1 AND ho
 constexpr const char* kLeases =
     "SELECT vehicle, holder, expires_ns FROM leases ORDER BY vehicle COLLATE \"C\"";
 
-// Folds held only in memory did not survive the previous process (store.hpp, Folding).
-constexpr const char* kResetFoldedMarks =
+// $1 < 0: every run.
+constexpr const char* kRestartFolds =
     "UPDATE ledger SET folded_through = coalesce((SELECT max(folded_through) FROM checkpoints c "
-    "WHERE c.run_id = ledger.run_id), -1)";
+    "WHERE c.run_id = ledger.run_id), -1) WHERE $1 < 0 OR "
+    "run_id IN (SELECT id FROM runs WHERE vehicle_id = $1)";
 
 class PostgresTransaction final : public Backend::Transaction {
  public:
@@ -174,9 +175,6 @@ PostgresBackend::PostgresBackend(const std::string& uri, const StoreOptions& opt
     : uri_(uri), connection_(uri, "store " + for_messages(uri)) {
   configure_session(connection_, options);
   postgres::bring_up_to_date(connection_);
-  pq::Transaction transaction(connection_);
-  connection_.exec(kResetFoldedMarks, "reset folded marks");
-  transaction.commit();
 }
 
 std::unique_ptr<Backend::Transaction> PostgresBackend::begin() {
@@ -264,6 +262,10 @@ void PostgresBackend::set_contiguous(std::int64_t run_id, std::int64_t mark) {
 
 void PostgresBackend::set_folded(std::int64_t run_id, std::int64_t mark) {
   connection_.run(kSetFolded, Params().i64(run_id).i64(mark));
+}
+
+void PostgresBackend::restart_folds(std::optional<std::int64_t> vehicle_id) {
+  connection_.run(kRestartFolds, Params().i64(vehicle_id.value_or(-1)));
 }
 
 std::unique_ptr<ChunkRows> PostgresBackend::chunk_rows(std::int64_t run_id, std::int64_t from,

@@ -57,6 +57,7 @@ class PostgresBackend final : public Backend {
   std::int64_t contiguous_from(std::int64_t run_id, std::int64_t from) override;
   void set_contiguous(std::int64_t run_id, std::int64_t mark) override;
   void set_folded(std::int64_t run_id, std::int64_t mark) override;
+  void restart_folds(std::optional<std::int64_t> vehicle_id) override;
   std::unique_ptr<ChunkRows> chunk_rows(std::int64_t run_id, std::int64_t from,
                                         std::int64_t to) override;
 

@@ -56,22 +56,10 @@ void configure(Database& db, const StoreOptions& options) {
   bring_up_to_date(db);
 }
 
-// Folds held only in memory did not survive the previous process: the durable folded state
-// is each run's latest checkpoint.
-void reset_folded_marks(Database& db) {
-  Transaction transaction(db);
-  db.exec(
-      "UPDATE ledger SET folded_through = coalesce((SELECT max(folded_through) FROM checkpoints "
-      "c WHERE c.run_id = ledger.run_id), -1)",
-      "reset folded marks");
-  transaction.commit();
-}
-
 }  // namespace
 
 Configured::Configured(Database& db, const StoreOptions& options) {
   configure(db, options);
-  reset_folded_marks(db);
 }
 
 // ---- transactions ----------------------------------------------------------------------
@@ -215,6 +203,10 @@ void SqliteBackend::set_contiguous(std::int64_t run_id, std::int64_t mark) {
 
 void SqliteBackend::set_folded(std::int64_t run_id, std::int64_t mark) {
   set_folded_.start().bind(1, run_id).bind(2, mark).run();
+}
+
+void SqliteBackend::restart_folds(std::optional<std::int64_t> vehicle_id) {
+  restart_folds_.start().bind(1, vehicle_id.value_or(-1)).run();
 }
 
 std::unique_ptr<ChunkRows> SqliteBackend::chunk_rows(std::int64_t run_id, std::int64_t from,

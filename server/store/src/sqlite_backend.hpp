@@ -20,7 +20,7 @@
 
 namespace dynid::store::detail {
 
-/// Opens the file's connection properly: pragmas, integrity check, schema, folded marks.
+/// Opens the file's connection properly: pragmas, integrity check, schema.
 struct Configured {
   Configured(Database& db, const StoreOptions& options);
 };
@@ -49,6 +49,7 @@ class SqliteBackend final : public Backend {
   std::int64_t contiguous_from(std::int64_t run_id, std::int64_t from) override;
   void set_contiguous(std::int64_t run_id, std::int64_t mark) override;
   void set_folded(std::int64_t run_id, std::int64_t mark) override;
+  void restart_folds(std::optional<std::int64_t> vehicle_id) override;
   std::unique_ptr<ChunkRows> chunk_rows(std::int64_t run_id, std::int64_t from,
                                         std::int64_t to) override;
 
@@ -93,6 +94,11 @@ class SqliteBackend final : public Backend {
                          "JOIN runs r ON r.id = l.run_id WHERE l.run_id = ?1"};
   Statement set_contiguous_{db_, "UPDATE ledger SET contiguous_through = ?2 WHERE run_id = ?1"};
   Statement set_folded_{db_, "UPDATE ledger SET folded_through = ?2 WHERE run_id = ?1"};
+  // ?1 < 0: every run.
+  Statement restart_folds_{db_,
+                           "UPDATE ledger SET folded_through = coalesce((SELECT max(folded_through) "
+                           "FROM checkpoints c WHERE c.run_id = ledger.run_id), -1) WHERE ?1 < 0 OR "
+                           "run_id IN (SELECT id FROM runs WHERE vehicle_id = ?1)"};
   Statement newest_checkpoint_{db_,
                                "SELECT folded_through, state, crc FROM checkpoints WHERE run_id "
                                "= ?1 ORDER BY folded_through DESC LIMIT 1"};

@@ -132,6 +132,10 @@ class RunService {
   /// or lost (not: its writes fail), and before serving one whose lease it just took: the runs
   /// are then loaded from the store again (lease_keeper.hpp).
   void forget(const std::string& vehicle, bool save);
+  /// Before serving a vehicle whose lease this server just took: forget(vehicle, false), and
+  /// its runs' folded marks set back to their checkpoints, from where they are folded again
+  /// (store.hpp, Folding). A lease lost meanwhile is reported as for a write (lease_lost).
+  void take_over(const std::string& vehicle);
   /// How a write refused for a lost lease (store::NotHolderError) is reported: the vehicle's
   /// chunks of that batch are not acknowledged, its runs are dropped (forget), and `lost`
   /// (the server: LeaseKeeper::forget) is told. Set before the first chunk.

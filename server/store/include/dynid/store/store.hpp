@@ -39,9 +39,12 @@
 // Folding. The ledger also keeps the highest sequence folded into the live accumulators
 // (mark_folded, monotonic, never past c). A checkpoint is the accumulators' state after folding
 // 0..folded_through; it is saved together with the ledger's folded mark in one transaction.
-// In-memory folds do not survive a restart, so opening the store resets every run's folded
-// mark to its latest checkpoint (or none): restart = latest_checkpoint(), then replay
-// chunks(folded_through + 1, highest_contiguous()). Nothing is lost, nothing folded twice.
+// In-memory folds do not survive their process: restart = latest_checkpoint(), then replay
+// chunks(folded_through + 1, highest_contiguous()), the folded mark first set back to the
+// checkpoint (or none). With one server per store (no holder) opening the store does that for
+// every run. In a shared store (StoreOptions::holder) the other servers' folds are alive, so
+// opening changes nothing: a server calls restart_folds(vehicle) when it takes a vehicle's
+// lease, for that vehicle's runs only. Nothing is lost, nothing folded twice.
 // Only a run's newest checkpoint is kept. A damaged one is reported (CorruptionError), and the
 // run can still be rebuilt by replaying its chunks from #0.
 //
@@ -191,6 +194,10 @@ class Store {
   ChunkStream chunks(const RunKey& run, std::uint64_t from, std::uint64_t to);
   /// The live accumulators have folded 0..sequence.
   void mark_folded(const RunKey& run, std::uint64_t sequence);
+  /// The caller folds the vehicle's runs again from their newest checkpoints (a holder that
+  /// has just taken the vehicle's lease): each run's folded mark goes back to its checkpoint.
+  /// A write of the vehicle (fenced under a holder). An unknown vehicle: nothing to do.
+  void restart_folds(const std::string& vehicle);
   /// Saves the state after folding 0..folded_through and raises the folded mark to it, in one
   /// transaction. folded_through must not exceed highest_contiguous() nor go below the latest
   /// checkpoint's; the same checkpoint again is a no-op, a different one at the same mark is
