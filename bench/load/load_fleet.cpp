@@ -78,6 +78,9 @@ struct Vehicle {
   std::unique_ptr<std::atomic<std::int64_t>[]> written_at;  // ns since the origin
   std::atomic<std::uint64_t> written{0};                    // chunks 0..written-1 have been written
   std::atomic<std::int64_t> acked{-2};  // highest contiguous; -2: announcement not accepted
+  // Writing thread only (resend_overdue): the ack mark last seen and since when it stands.
+  std::int64_t progress_mark = -2;
+  Clock::time_point last_progress{};
   // Receiver thread only:
   std::uint64_t next_ack = 0, next_estimate = 0, last_rows = 0;
   bool has_estimate = false;
@@ -105,6 +108,9 @@ class Fleet {
   void connect();
   void stream();
   void send(Vehicle& v, std::uint64_t k);
+  void write(Vehicle& v, const dynid_wire_Chunk& sample);
+  void resend_overdue();
+  void wait_until(Clock::time_point due);
   void receive_loop();
   void take_acks();
   void take_estimates();
@@ -130,6 +136,8 @@ class Fleet {
   std::int64_t last_ack_ns_ = 0, last_estimate_ns_ = 0;
   std::vector<double> rss_t_, rss_mb_;
   std::atomic<std::uint64_t> retries_{0};
+  std::uint64_t resent_ = 0, resend_rounds_ = 0;  // writing thread only
+  Clock::time_point last_resend_check_{};
   ProcessStats server_start_{}, server_end_{};
   double load_cpu_start_ = 0.0;
 };
@@ -139,9 +147,11 @@ void Fleet::connect() {
   for (auto& v : vehicles_) {
     const auto left =
         std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
-    if (!v->chunk_writer.wait_for_readers(1, std::max(left, std::chrono::milliseconds(1))) ||
-        !v->announcements.wait_for_readers(1, std::chrono::milliseconds(1000)))
-      throw std::runtime_error("load: no server discovered for " + v->id + " within the patience");
+    const auto wait = std::max(left, std::chrono::milliseconds(1));
+    if (!v->chunk_writer.wait_for_readers(options_.servers, wait) ||
+        !v->announcements.wait_for_readers(options_.servers, wait))
+      throw std::runtime_error(fmt::format("load: {} server(s) not discovered for {} within the patience",
+                                           options_.servers, v->id));
   }
   for (auto& v : vehicles_)
     v->announcements.write(dds::to_wire(run_.announcement(v->id, options_.run)).data);
@@ -158,12 +168,50 @@ void Fleet::connect() {
 
 void Fleet::send(Vehicle& v, std::uint64_t k) {
   const auto sample = dds::to_wire(run_.chunk(v.id, options_.run, k));
-  v.written_at[k].store(ns_since(origin_), std::memory_order_relaxed);
+  v.written_at[k].store(ns_since(origin_), std::memory_order_relaxed);  // the first send only
   v.written.store(k + 1, std::memory_order_release);
-  while (
-      !v.chunk_writer.write(sample.data)) {  // the server's reader is full: retry, as a spool does
+  write(v, sample.data);
+}
+
+void Fleet::write(Vehicle& v, const dynid_wire_Chunk& sample) {
+  while (!v.chunk_writer.write(sample)) {  // the server's reader is full: retry, as a spool does
     retries_.fetch_add(1);
     if (stop_.load()) return;
+  }
+}
+
+// dynid-car's resend rule (load_fleet.hpp), checked at most every 10 ms.
+void Fleet::resend_overdue() {
+  const auto now = Clock::now();
+  if (now - last_resend_check_ < std::chrono::milliseconds(10)) return;
+  last_resend_check_ = now;
+  for (auto& vehicle : vehicles_) {
+    Vehicle& v = *vehicle;
+    const std::int64_t acked = v.acked.load();
+    const auto first = static_cast<std::uint64_t>(std::max<std::int64_t>(acked + 1, 0));
+    const std::uint64_t written = v.written.load();
+    if (acked > v.progress_mark || first >= written) {  // progress, or nothing in flight
+      v.progress_mark = std::max(v.progress_mark, acked);
+      v.last_progress = now;
+      continue;
+    }
+    if (now - v.last_progress < options_.ack_timeout) continue;
+    ++resend_rounds_;
+    for (std::uint64_t k = first; k < written && !stop_.load(); ++k) {
+      write(v, dds::to_wire(run_.chunk(v.id, options_.run, k)).data);
+      ++resent_;
+    }
+    v.last_progress = Clock::now();
+  }
+}
+
+// Sleeps until `due`, resending what is overdue meanwhile.
+void Fleet::wait_until(Clock::time_point due) {
+  for (;;) {
+    resend_overdue();
+    const auto now = Clock::now();
+    if (now >= due) return;
+    std::this_thread::sleep_until(std::min(due, now + std::chrono::milliseconds(10)));
   }
 }
 
@@ -177,13 +225,14 @@ void Fleet::stream() {
       const auto due =
           start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
                       period * static_cast<double>(j) / static_cast<double>(n)));
-      std::this_thread::sleep_until(due);
+      wait_until(due);
       send(*vehicles_[j % n], j / n);
     }
     return;
   }
   std::uint64_t sent = 0;
   while (sent < total) {
+    resend_overdue();
     bool any = false;
     for (auto& v : vehicles_) {
       const std::uint64_t k = v->written.load();
@@ -268,11 +317,11 @@ void Fleet::receive_loop() {
 }
 
 void Fleet::sample_rss() {
-  if (options_.server_pid <= 0 || options_.rss_period.count() <= 0) return;
+  if (options_.server_pids.empty() || options_.rss_period.count() <= 0) return;
   auto next = Clock::now();
   while (!stop_.load()) {
     rss_t_.push_back(seconds_between(origin_, Clock::now()));
-    rss_mb_.push_back(static_cast<double>(read_process_stats(options_.server_pid).rss_bytes) /
+    rss_mb_.push_back(static_cast<double>(read_process_stats(options_.server_pids).rss_bytes) /
                       1048576.0);
     next += options_.rss_period;
     while (!stop_.load() && Clock::now() < next)
@@ -282,7 +331,7 @@ void Fleet::sample_rss() {
 
 LoadResult Fleet::run() {
   connect();
-  if (options_.server_pid > 0) server_start_ = read_process_stats(options_.server_pid);
+  if (!options_.server_pids.empty()) server_start_ = read_process_stats(options_.server_pids);
   load_cpu_start_ = own_cpu_seconds();
   origin_ = Clock::now();
   std::thread receiver([this] { receive_loop(); });
@@ -297,8 +346,8 @@ LoadResult Fleet::run() {
   }
   const auto drain_end = Clock::now() + options_.drain;
   while (Clock::now() < drain_end && !done())
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  if (options_.server_pid > 0) server_end_ = read_process_stats(options_.server_pid);
+    wait_until(Clock::now() + std::chrono::milliseconds(10));
+  if (!options_.server_pids.empty()) server_end_ = read_process_stats(options_.server_pids);
   stop_.store(true);
   receiver.join();
   rss.join();
@@ -308,7 +357,11 @@ LoadResult Fleet::run() {
 LoadResult Fleet::summarize() {
   LoadResult r;
   r.vehicles = vehicles_.size();
+  r.servers = options_.servers;
   r.write_retries = retries_.load();
+  r.resent_chunks = resent_;
+  r.resend_rounds = resend_rounds_;
+  r.ack_timeout_ms = options_.ack_timeout.count();
   r.rejections = rejections_;
   r.chunk_bytes = static_cast<std::size_t>(options_.chunk_rows) * (run_.channels() * 8 + 1);
   for (const auto& v : vehicles_) {
@@ -337,7 +390,7 @@ LoadResult Fleet::summarize() {
   r.estimate_p99_ms = quantile(estimate_ms_, 0.99);
   r.estimate_max_ms = quantile(estimate_ms_, 1.0);
   r.latency_samples = estimate_ms_.size();
-  if (options_.server_pid > 0) {
+  if (!options_.server_pids.empty()) {
     r.server_cpu_seconds = server_end_.cpu_seconds - server_start_.cpu_seconds;
     r.server_rss_start_mb = static_cast<double>(server_start_.rss_bytes) / 1048576.0;
     r.server_rss_end_mb = static_cast<double>(server_end_.rss_bytes) / 1048576.0;
@@ -358,7 +411,8 @@ LoadResult Fleet::summarize() {
 
 std::string LoadResult::to_json() const {
   return fmt::format(
-      R"({{"vehicles":{},"chunks_written":{},"chunks_acked":{},"write_retries":{},"lost":{},)"
+      R"({{"vehicles":{},"servers":{},"chunks_written":{},"chunks_acked":{},"write_retries":{},)"
+      R"("resent_chunks":{},"resend_rounds":{},"ack_timeout_ms":{},"lost":{},)"
       R"("missed":{},"rejections":{},"unmeasurable":{},"vehicles_fully_acked":{},)"
       R"("vehicles_with_estimate":{},"final_rows_wrong":{},"sample_rows_acked":{},)"
       R"("sample_rows_folded":{},"model_rows_folded":{},"stream_seconds":{:.4f},"fold_seconds":{:.4f},)"
@@ -366,7 +420,8 @@ std::string LoadResult::to_json() const {
       R"("estimate_max_ms":{:.3f},"latency_samples":{},"chunk_bytes":{},"server_cpu_seconds":{:.3f},)"
       R"("server_rss_start_mb":{:.2f},"server_rss_end_mb":{:.2f},"server_peak_rss_mb":{:.2f},)"
       R"("rss_slope_kb_per_min":{:.2f},"rss_samples":{},"load_cpu_seconds":{:.3f},"rss_series_mb":[{:.2f}]}})",
-      vehicles, chunks_written, chunks_acked, write_retries, lost, missed, rejections, unmeasurable,
+      vehicles, servers, chunks_written, chunks_acked, write_retries, resent_chunks, resend_rounds,
+      ack_timeout_ms, lost, missed, rejections, unmeasurable,
       vehicles_fully_acked, vehicles_with_estimate, final_rows_wrong, sample_rows_acked,
       sample_rows_folded, model_rows_folded, stream_seconds, fold_seconds, ack_p50_ms, ack_p99_ms,
       estimate_p50_ms, estimate_p99_ms, estimate_max_ms, latency_samples, chunk_bytes,
@@ -378,6 +433,8 @@ LoadResult run_load(const LoadOptions& options) {
   if (options.vehicles < 1) throw InputError("load: --vehicles must be >= 1");
   if (options.chunks_per_vehicle < 1) throw InputError("load: --chunks must be >= 1");
   if (options.window < 1) throw InputError("load: --window must be >= 1");
+  if (options.servers < 1) throw InputError("load: --servers must be >= 1");
+  if (options.ack_timeout.count() < 1) throw InputError("load: --ack-timeout must be > 0");
   Fleet fleet(options);
   return fleet.run();
 }

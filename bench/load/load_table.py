@@ -2,6 +2,7 @@
 """Medians of dynid-load's JSON lines (stdin) as the tables of docs/BENCHMARKS.md ("Load").
 
     load_table.py table DDSPERF_SAMPLES_PER_S PAYLOAD_BYTES < results.jsonl
+    load_table.py stores < results.jsonl     (run-load.sh stores: SQLite and PostgreSQL side by side)
     load_table.py soak < results.jsonl
 """
 import json
@@ -43,6 +44,47 @@ def table(rows, dds_rate, dds_bytes):
               f"{us_server:.2f} / {us_load:.2f} | {rss:.1f} ({rss_per:.0f}) |")
 
 
+def stores(rows):
+    """One row per (mode, N, store, servers), in the order the configurations first ran."""
+    print("ack latency: from the first send of a chunk to the first acknowledgement covering it "
+          "(resends included); rows/s: sample rows acknowledged / (first write -> last ack); "
+          "resent: chunks sent again after the ack timeout (median of the runs, max); stored once: "
+          "runs whose store holds each chunk exactly once with a contiguous ledger, all runs; "
+          "server CPU and RSS summed over the servers; CPU µs per row: the servers' over the stream, "
+          "PostgreSQL's (its server processes) from the servers' start to their stop, per sample row acknowledged")
+    print()
+    print("| mode | N | store | servers | runs (ok) | rows/s ingested | ack p50 / p99 ms | "
+          "chunk->estimate p50 / p99 ms | resent (max) | lost | stored once | server CPU % | "
+          "CPU µs per row, servers / PostgreSQL | server RSS MB end |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    keys = []
+    for r in rows:
+        key = (r["mode"], r["vehicles"], r.get("store", "sqlite"), r.get("servers", 1))
+        if key not in keys:
+            keys.append(key)
+    keys.sort(key=lambda k: (k[0], k[1]))  # stable: the stores keep their order
+    for mode, n, store, servers in keys:
+        rs = [r for r in rows if (r["mode"], r["vehicles"], r.get("store", "sqlite"), r.get("servers", 1))
+              == (mode, n, store, servers)]
+        ok = sum(1 for r in rs if r["status"] == 0)
+        ingest = med([r["sample_rows_acked"] / r["stream_seconds"] for r in rs if r["stream_seconds"] > 0])
+        cpu = med([100 * r["server_cpu_seconds"] / r["stream_seconds"] for r in rs if r["stream_seconds"] > 0])
+        resent = [r.get("resent_chunks", 0) for r in rs]
+        lost = max(r["lost"] + r["missed"] for r in rs)
+        once = sum(r.get("store_runs_complete", 0) for r in rs)
+        runs = sum(r["vehicles"] for r in rs)
+        per_row = [r for r in rs if r["sample_rows_acked"] > 0]
+        us_server = med([1e6 * r["server_cpu_seconds"] / r["sample_rows_acked"] for r in per_row])
+        us_db = med([1e6 * r.get("db_cpu_seconds", 0) / r["sample_rows_acked"] for r in per_row])
+        db = f"{us_db:.2f}" if store == "postgresql" else "-"
+        print(f"| {mode} | {n} | {store} | {servers} | {len(rs)} ({ok}) | {ingest:,.0f} | "
+              f"{med([r['ack_p50_ms'] for r in rs]):.1f} / {med([r['ack_p99_ms'] for r in rs]):.1f} | "
+              f"{med([r['estimate_p50_ms'] for r in rs]):.1f} / {med([r['estimate_p99_ms'] for r in rs]):.1f} | "
+              f"{med(resent):.0f} ({max(resent)}) | {lost} | {once} / {runs} | {cpu:.0f} | "
+              f"{us_server:.2f} / {db} | "
+              f"{med([r['server_rss_end_mb'] for r in rs]):.1f} |")
+
+
 def soak(rows):
     for r in rows:
         print(f"soak: {r['vehicles']} vehicles, {r['chunks_acked']}/{r['chunks_written']} chunks acked, "
@@ -59,6 +101,8 @@ def main():
     rows = [json.loads(line) for line in sys.stdin if line.strip()]
     if sys.argv[1] == "table":
         table(rows, float(sys.argv[2]), int(sys.argv[3]))
+    elif sys.argv[1] == "stores":
+        stores(rows)
     else:
         soak(rows)
 

@@ -57,6 +57,17 @@ ProcessStats read_process_stats(pid_t pid) {
   return s;
 }
 
+ProcessStats read_process_stats(const std::vector<pid_t>& pids) {
+  ProcessStats total;
+  for (const pid_t pid : pids) {
+    const ProcessStats one = read_process_stats(pid);
+    total.cpu_seconds += one.cpu_seconds;
+    total.rss_bytes += one.rss_bytes;
+    total.peak_rss_bytes += one.peak_rss_bytes;
+  }
+  return total;
+}
+
 double slope(const std::vector<double>& x, const std::vector<double>& y) {
   const std::size_t n = std::min(x.size(), y.size());
   if (n < 2) return 0.0;

@@ -4,6 +4,7 @@
 // read_process_stats(pid): CPU time used so far (utime + stime of /proc/<pid>/stat, seconds),
 // resident memory now (VmRSS) and its peak (VmHWM) from /proc/<pid>/status, in bytes. Throws
 // InputError naming the file when the process does not exist or a field is missing.
+// read_process_stats(pids): the same, summed over the processes.
 #include <sys/types.h>
 
 #include <cstdint>
@@ -18,6 +19,9 @@ struct ProcessStats {
 };
 
 ProcessStats read_process_stats(pid_t pid);
+/// The sum over several processes (servers sharing the vehicles); peak RSS is the sum of each
+/// one's peak (an upper bound on the peak of the sum). Zeros for none.
+ProcessStats read_process_stats(const std::vector<pid_t>& pids);
 
 /// Least-squares slope of y against x (units of y per unit of x); 0 for fewer than 2 points.
 double slope(const std::vector<double>& x, const std::vector<double>& y);

@@ -574,6 +574,9 @@ void RunService::publish_pending(const std::string& vehicle) {
 
 void RunService::forget(const std::string& vehicle, bool save) {
   flush_pending();
+  // Given back: what it folded since its last publication goes out now; no other server
+  // publishes the vehicle's estimates before its next chunk.
+  if (save) publish_pending(vehicle);
   drop(vehicle, save);
 }
 

@@ -127,8 +127,8 @@ class RunService {
   /// ledger is then up to date (before a request reads it, and on every tick).
   void settle();
   /// Drops every run of `vehicle` from memory, after flush_pending() (its chunks received so far
-  /// are stored or refused, and acknowledged if stored); with `save`, after saving its unsaved
-  /// folded marks and checkpoints too. For a vehicle whose lease this server gives back (save)
+  /// are stored or refused, and acknowledged if stored); with `save`, after publishing its
+  /// estimates not published yet and saving its unsaved folded marks and checkpoints too. For a vehicle whose lease this server gives back (save)
   /// or lost (not: its writes fail), and before serving one whose lease it just took: the runs
   /// are then loaded from the store again (lease_keeper.hpp).
   void forget(const std::string& vehicle, bool save);
