@@ -32,6 +32,7 @@ const std::map<std::string, KindSpec>& kinds() {
       {"trace", {{"vehicle", "run", "model"}, {"effects", "reference", "rounds", "format"}, {"reference"}}},
       {"consistency", {{"vehicle", "run"}, {"reference", "format"}, {"reference"}}},
       {"iv", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},
+      {"simex", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},
       {"status", {{}, {"format"}, {}}},
       {"fleet", {{"model", "shared", "vehicles"}, {"format"}, {"shared"}}},
   };

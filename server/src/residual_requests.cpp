@@ -6,6 +6,7 @@
 #include "dynid/ingest/recorded_run.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/report/iv_report.hpp"
+#include "dynid/report/simex_report.hpp"
 #include "dynid/report/residual_html.hpp"
 #include "dynid/report/residual_report.hpp"
 #include "dynid/residual/effect_comparison.hpp"
@@ -84,7 +85,7 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
     throw InputError("residual report: format '" + request.format + "' (text, json or html)");
   if (request.rounds < 0 || request.rounds > 10)
     throw InputError("trace: rounds " + std::to_string(request.rounds) + " (0 to 10)");
-  if ((request.kind == "consistency" || request.kind == "iv") && request.format == "html")
+  if ((request.kind == "consistency" || request.kind == "iv" || request.kind == "simex") && request.format == "html")
     throw InputError(request.kind + " report: format 'html' (text or json)");
   const ingest::RecordedRun run = ingest::assemble_run(announcement, chunks);
   const auto segments = ingest::preprocess_offline(run);
@@ -101,6 +102,11 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
     const residual::IvFit fit = iv_of(*model, declared, announcement, segments);
     if (request.format == "json") return {report::iv_json(fit), "application/json"};
     return {report::format_iv_text(fit), "text/plain"};
+  }
+  if (request.kind == "simex") {  // the live judgement's fit (same noise, same draws), on demand
+    const residual::SimexFit fit = simex_of(*model, declared, run, segments, run_noise(run, segments));
+    if (request.format == "json") return {report::simex_json(fit), "application/json"};
+    return {report::format_simex_text(fit), "text/plain"};
   }
   if (request.kind == "trace") {
     residual::TraceOptions options;

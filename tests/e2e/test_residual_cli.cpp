@@ -373,6 +373,29 @@ TEST(E2eResidualCli, WhereTheBiasTestDoesNotRejectTheTablesCarryTheOfflineSimexV
   EXPECT_GE(by_simex, 1) << "no table by SIMEX: the test shows nothing\n" << tables.dump(1);
   const auto text = dynid({"estimates", "--vehicle", "sx-car", "--run", "run-s"}).out;
   EXPECT_NE(text.find("values by SIMEX where marked"), std::string::npos) << text;
+
+  // On demand (`dynid simex`): the same fit, in JSON and for people.
+  for (const auto& [name, simex] : offline) {
+    const auto reply = dynid({"--json", "simex", "--vehicle", "sx-car", "--run", "run-s", "--model", name});
+    ASSERT_EQ(reply.exit_code, 0) << reply.err;
+    const auto json = nlohmann::json::parse(reply.out);
+    EXPECT_EQ(json["corrected"], simex.corrected()) << name;
+    ASSERT_EQ(json["parameters"].size(), simex.parameters.size()) << name;
+    for (std::size_t k = 0; k < simex.parameters.size(); ++k) {
+      const auto& p = json["parameters"][k];
+      const auto j = static_cast<Eigen::Index>(k);
+      EXPECT_EQ(p["simex"], simex.value(j)) << name << " " << p["name"];
+      EXPECT_EQ(p["simex_std"], simex.std(j)) << name << " " << p["name"];
+      EXPECT_EQ(p["simex_published"], simex.improves(j)) << name << " " << p["name"];
+    }
+  }
+  const auto people = dynid({"simex", "--vehicle", "sx-car", "--run", "run-s", "--model", offline.begin()->first});
+  ASSERT_EQ(people.exit_code, 0) << people.err;
+  EXPECT_NE(people.out.find("SIMEX: " + offline.begin()->first), std::string::npos) << people.out;
+  EXPECT_NE(people.out.find("verdict: "), std::string::npos) << people.out;
+  const auto wrong = dynid({"simex", "--vehicle", "sx-car", "--run", "run-s", "--model", "no_such_model"});
+  EXPECT_NE(wrong.exit_code, 0);
+  EXPECT_NE(wrong.err.find("no_such_model"), std::string::npos) << wrong.err;
 }
 
 }  // namespace
