@@ -36,6 +36,7 @@ ServerOptions with_holder(ServerOptions options) {
   if (!options.leased()) return options;
   if (options.server_id.empty()) options.server_id = default_server_id();
   options.store.holder = options.server_id;
+  options.store.shared = true;  // the lease keeper's unfenced connection too
   return options;
 }
 

@@ -98,6 +98,10 @@ TEST_P(StoreLeases, ATakeoverSetsOnlyItsVehiclesFoldedMarksBackToTheirCheckpoint
   }
   Store second = open(held_by("server-b"));
   EXPECT_EQ(second.folded_through({"proto-17", "run-1"}), 5u);  // opening changed nothing
+  StoreOptions keeper;  // a server's lease keeper: shared, not fenced
+  keeper.shared = true;
+  Store unfenced = open(keeper);
+  EXPECT_EQ(unfenced.folded_through({"proto-17", "run-1"}), 5u);
   EXPECT_THROW(second.restart_folds("proto-17"), NotHolderError);  // not its vehicle yet
 
   first.release_lease("proto-17", "server-a");

@@ -78,7 +78,7 @@ std::unique_ptr<detail::Backend::Transaction> Store::Impl::begin_write(const std
 
 Store::Store(const std::string& location, StoreOptions options)
     : impl_(std::make_unique<Impl>(detail::open_backend(location, options), options)) {
-  if (!impl_->options.holder.empty()) return;  // shared: each holder restarts what it takes
+  if (impl_->options.shared || !impl_->options.holder.empty()) return;  // each holder restarts what it takes
   const auto transaction = impl_->backend->begin();
   impl_->backend->restart_folds(std::nullopt);
   transaction->commit();

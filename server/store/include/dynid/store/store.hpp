@@ -41,8 +41,8 @@
 // 0..folded_through; it is saved together with the ledger's folded mark in one transaction.
 // In-memory folds do not survive their process: restart = latest_checkpoint(), then replay
 // chunks(folded_through + 1, highest_contiguous()), the folded mark first set back to the
-// checkpoint (or none). With one server per store (no holder) opening the store does that for
-// every run. In a shared store (StoreOptions::holder) the other servers' folds are alive, so
+// checkpoint (or none). With one server per store opening the store does that for every run.
+// In a shared store (StoreOptions::shared or holder) the other servers' folds are alive, so
 // opening changes nothing: a server calls restart_folds(vehicle) when it takes a vehicle's
 // lease, for that vehicle's runs only. Nothing is lost, nothing folded twice.
 // Only a run's newest checkpoint is kept. A damaged one is reported (CorruptionError), and the
@@ -117,6 +117,11 @@ struct StoreOptions {
   std::int64_t max_pages = 0;
   /// The server id whose leases fence this store's writes (Leases above); empty: no fencing.
   std::string holder;
+  /// Several servers use this store under leases, this connection unfenced or not (a server's
+  /// lease keeper reads and takes leases without a holder). A store opened with a holder is
+  /// shared whatever this says. Opening a store that is not shared sets every run's folded
+  /// mark back to its checkpoint (Folding above).
+  bool shared = false;
 };
 
 enum class ChunkStatus {
