@@ -7,7 +7,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
-#include <Eigen/SVD>
+#include <Eigen/Eigenvalues>
 #include <boost/math/distributions/chi_squared.hpp>
 
 namespace dynid::residual::detail {
@@ -45,12 +45,31 @@ TimeScores scores_by_time(const FoldedRows& rows, const Eigen::VectorXd& x, cons
   return sum_by_grid(grid, stacked);
 }
 
+// Divides each score component by its root mean square (1 where it is 0) and returns those
+// scales. Why: the covariance must not depend on the parameters' units. Andrews' bandwidth weighs
+// the components by their variances, and a column in kN rather than N would otherwise move it;
+// on unit-scaled scores the whole estimate is equivariant, S = D S_unit D.
+Eigen::VectorXd to_unit_scale(TimeScores& t) {
+  const Eigen::Index k = t.score.empty() ? 0 : t.score.front().size();
+  Eigen::VectorXd rms = Eigen::VectorXd::Zero(k);
+  for (const Eigen::VectorXd& s : t.score) rms += s.cwiseAbs2();
+  if (!t.score.empty()) rms = (rms / static_cast<double>(t.score.size())).cwiseSqrt();
+  for (Eigen::Index a = 0; a < k; ++a)
+    if (!(rms(a) > 0.0)) rms(a) = 1.0;
+  for (Eigen::VectorXd& s : t.score) s = s.cwiseQuotient(rms);
+  return rms;
+}
+
 // Andrews and Monahan (1992): the scores are prewhitened by a VAR(1) fitted over pairs of rows
 // one decimation step apart, s_t = A s_{t-1} + v_t, the HAC estimate is taken of v and recoloured,
 // S = (I - A)^-1 S_v (I - A)^-T. Why: low-passed rows make the scores strongly autocorrelated,
 // and a kernel estimate alone then understates their long-run variance on a run of a few hundred
-// rows (the test over-rejects); prewhitening leaves the kernel little to do. A is shrunk to a
-// spectral norm of 0.97 at most, as they advise, so that (I - A) stays invertible.
+// rows (the test over-rejects, the stds are short); prewhitening leaves the kernel little to do.
+// A is shrunk to a spectral radius of 0.97 at most (their bound), so that the VAR is stationary
+// and (I - A) invertible. The radius, not the spectral norm: the scores of correlated columns
+// give a non-normal A whose norm is several times its radius (measured: 2.5 against 0.1 on the
+// clutch model's unit-scaled scores), and bounding the norm shrank such an A to nearly nothing,
+// which is no prewhitening at all.
 Eigen::MatrixXd prewhiten(TimeScores& t, int odmf) {
   const Eigen::Index k = t.score.empty() ? 0 : t.score.front().size();
   Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(k, k);
@@ -63,8 +82,8 @@ Eigen::MatrixXd prewhiten(TimeScores& t, int odmf) {
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(k, k);
   if (lagged.trace() > 0.0)
     a = lagged.transpose().completeOrthogonalDecomposition().solve(cross.transpose()).transpose();
-  const double norm = a.size() > 0 ? a.jacobiSvd().singularValues()(0) : 0.0;
-  if (norm > 0.97) a *= 0.97 / norm;
+  const double radius = a.size() > 0 ? a.eigenvalues().cwiseAbs().maxCoeff() : 0.0;
+  if (radius > 0.97) a *= 0.97 / radius;
   for (std::size_t i = t.score.size(); i-- > 1;)
     if (t.grid[i] - t.grid[i - 1] == odmf) t.score[i] -= a * t.score[i - 1];
   return a;
@@ -140,11 +159,12 @@ TimeScores sum_by_grid(const std::vector<Eigen::Index>& grid, const Eigen::Matri
 }
 
 Eigen::MatrixXd long_run_covariance(TimeScores t, int odmf, int& bandwidth) {
+  const Eigen::VectorXd unit = to_unit_scale(t);
   const Eigen::MatrixXd whitening = prewhiten(t, odmf);
   bandwidth = andrews_bandwidth(t, odmf);
   const Eigen::MatrixXd recolour =
       (Eigen::MatrixXd::Identity(whitening.rows(), whitening.cols()) - whitening).completeOrthogonalDecomposition().pseudoInverse();
-  return recolour * newey_west(t, bandwidth, odmf) * recolour.transpose();
+  return unit.asDiagonal() * (recolour * newey_west(t, bandwidth, odmf) * recolour.transpose()) * unit.asDiagonal();
 }
 
 WaldTest hac_wald_test(const FoldedRows& rows, const Eigen::VectorXd& x, const std::vector<double>& weights,
