@@ -19,7 +19,7 @@ nlohmann::json sample_json(const ParameterSample& s) {
           {"iv_hac_std", number(s.iv_hac_std)}, {"dwh_rejects", s.dwh_rejects}, {"iv_refused", s.iv_refused},
           {"iv_instrument_f", number(s.iv_instrument_f)}, {"simex_value", number(s.simex_value)},
           {"simex_std", number(s.simex_std)}, {"simex_mc_std", number(s.simex_mc_std)},
-          {"simex_corrected", s.simex_corrected}, {"simex_improves", s.simex_improves}};
+          {"simex_corrected", s.simex_corrected},           {"simex_over_iv", s.simex_over_iv}};
 }
 
 nlohmann::json run_json(const SeedRun& r) {

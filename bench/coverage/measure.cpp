@@ -10,6 +10,7 @@
 #include "dynid/model/registry.hpp"
 #include "dynid/residual/noise_floor.hpp"
 #include "dynid/residual/simex.hpp"
+#include "dynid/residual/simex_against_iv.hpp"
 
 namespace dynid::benchcoverage {
 namespace {
@@ -39,6 +40,7 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
   const residual::ModelParameters hac = benchcar::declared_hac(profile, model, run.product.recorded, run.segments);
   const residual::IvFit iv = benchcar::declared_iv(profile, model, run.product.recorded, run.segments);
   const residual::SimexFit simex = declared_simex(profile, model, run, seed, simex_draws);
+  const bool simex_over_iv = residual::compare_simex_with_iv(iv, simex).simex_stands;
   for (std::size_t i = 0; i < fit.parameters.size(); ++i) {
     const std::string& name = fit.parameters[i].name;
     const auto truth = run.truth.parameters.find(name);
@@ -63,9 +65,9 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
       s.simex_value = simex.value(k);
       s.simex_std = simex.std(k);
       s.simex_mc_std = simex.monte_carlo_std(k);
-      s.simex_improves = simex.improves(k);
       s.simex_corrected = simex.corrected();
     }
+    s.simex_over_iv = simex_over_iv;
     s.dwh_rejects = iv.dwh.rejects;
     s.iv_instrument_f = iv.instrument_f;
     s.iv_refused = iv.reason;

@@ -40,8 +40,10 @@ struct ParameterSample {
   double simex_value = kNaN;
   double simex_std = kNaN;     ///< sqrt(LS HAC^2 + Monte Carlo^2 + noise level^2)
   double simex_mc_std = kNaN;  ///< its Monte Carlo part
-  bool simex_improves = false;  ///< residual::SimexFit::improves: SIMEX's estimated MSE below LS's
   bool simex_corrected = false;  ///< some channel's noise reaches the rows
+  /// Hausman's comparison lets SIMEX stand in for IV (residual::compare_simex_with_iv, the model's
+  /// fits as a whole): published in IV's place where DWH rejects least squares.
+  bool simex_over_iv = false;
   /// (value - truth) / |truth|: relative, so that a negative truth (the clutch's viscous slope)
   /// keeps the error's sign.
   double relative_error() const;

@@ -76,15 +76,17 @@ SimexCoverage simex_of(const std::vector<const ParameterSample*>& samples) {
   return c;
 }
 
-// with_simex false: what the server publishes today; true: SIMEX in place of the table's LS
-// where IV does not replace it and SIMEX's estimated mean squared error is below LS's.
+// with_simex false: IV where DWH rejects least squares, else least squares; true: the server's
+// rule (server/estimate_tables.hpp apply_iv, apply_simex): SIMEX in place of IV where Hausman's
+// comparison lets it stand, and in place of least squares wherever it corrected the rows.
 PublishedCoverage published_of(const std::vector<const ParameterSample*>& samples, bool with_simex) {
   PublishedCoverage c;
   std::vector<double> stds;
   for (const ParameterSample* s : samples) {
-    const bool iv = s->dwh_rejects && std::isfinite(s->iv_value) && std::isfinite(s->iv_hac_std);
-    const bool simex = with_simex && !iv && s->simex_improves && std::isfinite(s->simex_value) &&
-                       std::isfinite(s->simex_std);
+    const bool iv_estimated = s->dwh_rejects && std::isfinite(s->iv_value) && std::isfinite(s->iv_hac_std);
+    const bool simex = with_simex && (iv_estimated ? s->simex_over_iv : s->simex_corrected) &&
+                       std::isfinite(s->simex_value) && std::isfinite(s->simex_std);
+    const bool iv = iv_estimated && !simex;
     const double value = iv ? s->iv_value : simex ? s->simex_value : s->value;
     const double std = iv ? s->iv_hac_std : simex ? s->simex_std : s->std;
     if (!std::isfinite(value) || !std::isfinite(std)) continue;

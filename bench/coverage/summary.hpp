@@ -43,9 +43,9 @@ struct SimexCoverage {
 /// What a table publishes. `without_simex`: IV's value and HAC std where the model's
 /// Durbin-Wu-Hausman test rejects least squares at 1 %, else least squares' (what the server
 /// published before SIMEX). `published`: what the server publishes (server/estimate_tables.hpp,
-/// apply_iv then apply_simex): the same with SIMEX's value and std in place of least squares'
-/// where SIMEX's estimated mean squared error is below LS's (SimexFit::improves;
-/// docs/ACCURACY.md says why).
+/// apply_iv then apply_simex): SIMEX's value and std in place of least squares' wherever SIMEX
+/// corrected the rows, and in place of IV where Hausman's comparison lets it stand
+/// (residual/simex_against_iv.hpp; docs/ACCURACY.md says why).
 struct PublishedCoverage {
   int seeds = 0;     ///< seeds with a finite published value and std
   int by_iv = 0;     ///< of which by IV
@@ -88,8 +88,8 @@ std::string simex_markdown_table(const std::vector<ParameterCoverage>& rows);
 /// The table without SIMEX (IV where DWH rejects, else least squares), as a markdown table.
 std::string without_simex_markdown_table(const std::vector<ParameterCoverage>& rows);
 
-/// What the server publishes, as a markdown table (IV where DWH rejects, else SIMEX where it
-/// improves).
+/// What the server publishes, as a markdown table (IV where DWH rejects and SIMEX does not stand
+/// in for it, else SIMEX where it corrects, else least squares).
 std::string published_markdown_table(const std::vector<ParameterCoverage>& rows);
 
 }  // namespace dynid::benchcoverage

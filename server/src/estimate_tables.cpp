@@ -5,6 +5,7 @@
 
 #include "dynid/report/estimate_report.hpp"
 #include "dynid/report/json.hpp"
+#include "dynid/residual/simex_against_iv.hpp"
 
 namespace dynid::server {
 
@@ -63,6 +64,23 @@ void replace_rows(dds::EstimateTable& table, const std::vector<model::ParameterI
   table.estimator = estimator;
 }
 
+// Where IV replaced least squares: SIMEX takes every row IV took when Hausman's comparison says
+// its noise model holds (residual/simex_against_iv.hpp); the bias test's line says which way.
+void simex_in_place_of_iv(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
+                          const ls::WeightedEstimate& estimate, const residual::SimexFit& simex,
+                          const residual::IvFit& iv) {
+  const residual::SimexAgainstIv comparison = residual::compare_simex_with_iv(iv, simex);
+  if (!comparison.compared) return;
+  table.bias_test += "; " + comparison.statement();
+  if (!comparison.simex_stands) return;
+  std::vector<bool> replace(parameters.size());
+  for (std::size_t k = 0; k < replace.size(); ++k) {
+    const auto j = static_cast<Eigen::Index>(k);
+    replace[k] = std::isfinite(iv.value(j)) && std::isfinite(simex.value(j)) && std::isfinite(estimate.estimate.value(j));
+  }
+  replace_rows(table, parameters, estimate, simex.value, simex.std, replace, dds::kSimex);
+}
+
 }  // namespace
 
 void apply_iv(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
@@ -80,13 +98,18 @@ void apply_iv(dds::EstimateTable& table, const std::vector<model::ParameterInfo>
 }
 
 void apply_simex(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
-                 const ls::WeightedEstimate& estimate, const residual::SimexFit& simex) {
-  if (table.estimator != dds::kLeastSquares || !same_columns(parameters, simex.parameters, simex.value)) return;
+                 const ls::WeightedEstimate& estimate, const residual::SimexFit& simex, const residual::IvFit* iv) {
+  if (!same_columns(parameters, simex.parameters, simex.value)) return;
+  if (table.estimator == dds::kInstrumentalVariables) {
+    if (iv != nullptr) simex_in_place_of_iv(table, parameters, estimate, simex, *iv);
+    return;
+  }
+  if (table.estimator != dds::kLeastSquares) return;
   std::vector<bool> replace(parameters.size());
   bool any = false;
   for (std::size_t k = 0; k < replace.size(); ++k) {
     const auto j = static_cast<Eigen::Index>(k);
-    replace[k] = simex.improves(j) && std::isfinite(estimate.estimate.value(j)) &&
+    replace[k] = simex.corrected() && std::isfinite(simex.value(j)) && std::isfinite(estimate.estimate.value(j)) &&
                  table.parameters[k].status == ls::ParameterStatus::kIdentified;
     any = any || replace[k];
   }

@@ -180,15 +180,13 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
     } catch (const InputError&) {
       // No row yet: no IV estimate (a refusal for weak instruments is a result, not this).
     }
-    // SIMEX only where the table will stay least squares': where IV replaces it, the correction
-    // would not be published, and it costs the most of the three (2 x lambdas x draws refits).
-    if (!verdict.iv || !verdict.iv->replaces_least_squares()) {
-      try {
-        if (!noise) noise = run_noise(run, segments);
-        verdict.simex = simex_of(*model, spec.effects, run, segments, *noise);
-      } catch (const InputError&) {
-        // No row yet: no correction.
-      }
+    // SIMEX beside IV too: where IV replaces least squares, SIMEX stands in for it when Hausman's
+    // comparison of the two says its noise model holds (server/estimate_tables.hpp apply_simex).
+    try {
+      if (!noise) noise = run_noise(run, segments);
+      verdict.simex = simex_of(*model, spec.effects, run, segments, *noise);
+    } catch (const InputError&) {
+      // No row yet: no correction.
     }
     if (!verdict.verdict.empty() || verdict.iv || verdict.simex) out[spec.model] = std::move(verdict);
   }

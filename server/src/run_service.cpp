@@ -538,7 +538,8 @@ void RunService::attach_live(const RunState& run, const std::vector<ingest::Mode
                                        [&](const ingest::ModelEstimate& e) { return e.model == table.model; });
     if (estimate == estimates.end() || !estimate->estimate) continue;
     if (live.iv) apply_iv(table, estimate->parameters, *estimate->estimate, *live.iv, through);
-    if (live.simex) apply_simex(table, estimate->parameters, *estimate->estimate, *live.simex);
+    if (live.simex)
+      apply_simex(table, estimate->parameters, *estimate->estimate, *live.simex, live.iv ? &*live.iv : nullptr);
   }
 }
 

@@ -207,7 +207,9 @@ TEST(E2eResidualCli, TheLiveVerdictIsPublishedBesideTheEstimates) {
   // 1.2 of its std; the next test holds the values themselves.)
   const std::string bias_test = table["bias_test"].get<std::string>();
   ASSERT_FALSE(bias_test.empty()) << table.dump();
-  if (bias_test.rfind("least squares is biased", 0) == 0)
+  if (bias_test.find("SIMEX published") != std::string::npos)  // SIMEX stands in for IV
+    EXPECT_EQ(table["estimator"], "SIMEX") << bias_test;
+  else if (bias_test.rfind("least squares is biased", 0) == 0)
     EXPECT_EQ(table["estimator"], "instrumental variables") << bias_test;
   else  // least squares, or where the measured noise's correction lowers the error, SIMEX
     EXPECT_NE(table["estimator"], "instrumental variables") << bias_test;
@@ -251,7 +253,10 @@ TEST(E2eResidualCli, WhereTheBiasTestRejectsLeastSquaresTheTablesCarryTheIvValue
     else std::this_thread::sleep_for(std::chrono::milliseconds(500));
   }
   ASSERT_FALSE(table.is_null()) << "no IV values through chunk #" << last;
-  EXPECT_EQ(table["bias_test"], iv["statement"]);
+  // The test's line, then why SIMEX does not stand in for IV (on this run its correction is
+  // large, and so is its std: it is not the more precise of the two).
+  const std::string bias_test = table["bias_test"].get<std::string>();
+  EXPECT_EQ(bias_test.rfind(iv["statement"].get<std::string>() + "; IV kept", 0), 0u) << bias_test;
   const auto& sensor_scale = table["parameters"][0];
   ASSERT_EQ(sensor_scale["name"], "sensor_scale");
   EXPECT_EQ(sensor_scale["value"], iv["parameters"][0]["iv"]);  // the same stored chunks, the same fit
@@ -294,8 +299,8 @@ TEST(E2eResidualCli, WhereTheBiasTestRejectsLeastSquaresTheTablesCarryTheIvValue
 
 
 // Issue 16 item 2, where the bias test does not reject: the tables carry least squares corrected
-// for the measured sensor noise (SIMEX) on the rows where the correction lowers the estimated
-// error, the least-squares values beside them. Those values are the offline SIMEX fit of the
+// for the measured sensor noise (SIMEX) on every identified row, the least-squares values
+// beside them. Those values are the offline SIMEX fit of the
 // stored run (the chunks the car sent, assembled and preprocessed by the library, the noise
 // measured on them with the profile's declared sensors), in the reply and on the topic.
 TEST(E2eResidualCli, WhereTheBiasTestDoesNotRejectTheTablesCarryTheOfflineSimexValues) {
@@ -350,12 +355,11 @@ TEST(E2eResidualCli, WhereTheBiasTestDoesNotRejectTheTablesCarryTheOfflineSimexV
       const auto j = static_cast<Eigen::Index>(k);
       ASSERT_EQ(p["name"], simex.parameters[k].name);
       if (p["least_squares_value"].is_null()) {  // a row SIMEX does not replace
-        EXPECT_TRUE(!simex.improves(j) || p["status"] != "identified") << name << " " << p["name"];
+        EXPECT_TRUE(!std::isfinite(simex.value(j)) || p["status"] != "identified") << name << " " << p["name"];
         continue;
       }
       std::printf("%s %s: SIMEX %.9g +- %.3g (least squares %.9g)\n", name.c_str(),
                   p["name"].get<std::string>().c_str(), simex.value(j), simex.std(j), simex.ls_value(j));
-      EXPECT_TRUE(simex.improves(j)) << name << " " << p["name"];
       EXPECT_EQ(p["value"], simex.value(j)) << name << " " << p["name"];  // the same chunks, the same fit
       EXPECT_EQ(p["std"], simex.std(j)) << name << " " << p["name"];
       // The least-squares value beside it is the fold's, equal to SIMEX's theta(0) to the
@@ -386,7 +390,7 @@ TEST(E2eResidualCli, WhereTheBiasTestDoesNotRejectTheTablesCarryTheOfflineSimexV
       const auto j = static_cast<Eigen::Index>(k);
       EXPECT_EQ(p["simex"], simex.value(j)) << name << " " << p["name"];
       EXPECT_EQ(p["simex_std"], simex.std(j)) << name << " " << p["name"];
-      EXPECT_EQ(p["simex_published"], simex.improves(j)) << name << " " << p["name"];
+      EXPECT_EQ(p["simex_published"], simex.corrected() && std::isfinite(simex.value(j))) << name << " " << p["name"];
     }
   }
   const auto people = dynid({"simex", "--vehicle", "sx-car", "--run", "run-s", "--model", offline.begin()->first});

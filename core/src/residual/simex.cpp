@@ -227,12 +227,6 @@ double SimexFit::relative_correction(Eigen::Index i) const {
   return (value(i) - ls_value(i)) / std::abs(value(i));
 }
 
-bool SimexFit::improves(Eigen::Index i) const {
-  if (!corrected() || !std::isfinite(value(i))) return false;
-  const double correction = value(i) - ls_value(i);
-  return correction * correction > monte_carlo_std(i) * monte_carlo_std(i) + level_std(i) * level_std(i);
-}
-
 std::string SimexFit::statement() const {
   if (!corrected()) return "no measured noise reaches the regressors: the least-squares values stand";
   std::string channels;

@@ -106,11 +106,6 @@ struct SimexFit {
   bool corrected() const { return !contributing.empty(); }
   /// (value - ls_value) / |value| of parameter i (0 when not corrected).
   double relative_correction(Eigen::Index i) const;
-  /// True when value(i) has a smaller estimated mean squared error than ls_value(i), the rule for
-  /// publishing it (docs/ACCURACY.md): LS's is its bias, estimated by the correction, squared
-  /// plus its variance (hac^2); SIMEX's is std^2 = hac^2 + mc^2 + level^2. So: corrected, and
-  /// (value - ls_value)^2 > mc^2 + level^2: the correction exceeds its own uncertainty.
-  bool improves(Eigen::Index i) const;
   /// One line an engineer reads: which channels' noise was corrected, with the largest
   /// correction in std, or that no noise reaches the rows.
   std::string statement() const;

@@ -35,16 +35,21 @@ dds::EstimateTable table_of(const std::string& vehicle, const std::string& sourc
 void apply_iv(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
               const ls::WeightedEstimate& estimate, const residual::IvFit& iv, std::uint64_t through);
 
-/// The SIMEX correction on `table` (made by table_of, apply_iv applied first): where the table is
-/// still least squares', each identified parameter whose SIMEX value has a smaller estimated
-/// mean squared error than least squares' (SimexFit::improves: the correction exceeds its own
-/// Monte Carlo and noise-level uncertainty) gets SIMEX's value and std, with the least-squares
-/// ones it replaces beside it; statuses are classified again, and the estimator is kSimex when
-/// any row changed. Why not where IV replaces least squares: the bias test has then seen the bias
-/// in the data, and IV removes it with no noise model (docs/ACCURACY.md). A fit of other columns
-/// is not applied.
+/// The SIMEX correction on `table` (made by table_of, apply_iv applied first with `iv`, null when
+/// there is no IV fit). Where the table is still least squares' and SIMEX corrected the rows (some
+/// channel's noise reaches them), every identified parameter gets SIMEX's value and std, with the
+/// least-squares ones it replaces beside it; statuses are classified again, and the estimator is
+/// kSimex when any row changed. Why every one, even where the correction is within its own
+/// uncertainty: the fold's table std counts every decimated row as independent, and SIMEX's std
+/// (least squares' HAC std and the correction's own uncertainty) is the one that covers the error
+/// (docs/ACCURACY.md). Where IV replaced least squares (the bias test has
+/// seen the bias in the data), SIMEX takes IV's rows only when Hausman's comparison of the two
+/// says its noise model holds (residual::compare_simex_with_iv), and the bias test's line gets
+/// that comparison's statement either way (docs/ACCURACY.md). A fit of other columns is not
+/// applied.
 void apply_simex(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
-                 const ls::WeightedEstimate& estimate, const residual::SimexFit& simex);
+                 const ls::WeightedEstimate& estimate, const residual::SimexFit& simex,
+                 const residual::IvFit* iv = nullptr);
 
 EstimateTables tables_of(const std::string& vehicle, const std::string& source,
                          const std::vector<ingest::ModelEstimate>& estimates,
