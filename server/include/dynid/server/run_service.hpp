@@ -258,8 +258,9 @@ class RunService {
   void collect_residual_job();
   /// The run's live judgement into its tables (nothing when off or not computed): the residual
   /// verdict, and the bias test with IV's values where it rejects least squares (apply_iv),
-  /// else SIMEX's where they lower the estimated error (apply_simex; `estimates`: those the
-  /// tables were made from).
+  /// SIMEX's in their place where Hausman's comparison lets it stand, and elsewhere SIMEX's where
+  /// the measured noise reaches the rows (apply_simex; `estimates`: those the tables were made
+  /// from).
   static void attach_live(const RunState& run, const std::vector<ingest::ModelEstimate>& estimates,
                           EstimateTables& tables);
   /// Writes `tables` to the Estimate topic, each with the next revision (set in `tables`).

@@ -38,8 +38,8 @@ struct ParameterEntry {
 /// EstimateTable::estimator: least squares (the fold's estimate, and what an older server
 /// publishes), instrumental variables where the live bias test rejects least squares, or SIMEX
 /// (least squares corrected for the measured sensor noise, residual/simex.hpp) where the test
-/// does not reject and the correction lowers the estimated error of some row, or where it
-/// rejects and Hausman's comparison lets SIMEX stand in for IV (residual/simex_against_iv.hpp).
+/// does not reject and that noise reaches the rows, or where it rejects and Hausman's comparison
+/// lets SIMEX stand in for IV (residual/simex_against_iv.hpp).
 inline constexpr const char* kLeastSquares = "least squares";
 inline constexpr const char* kInstrumentalVariables = "instrumental variables";
 inline constexpr const char* kSimex = "SIMEX";
