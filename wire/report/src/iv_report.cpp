@@ -6,18 +6,19 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "cells.hpp"
+
 namespace dynid::report {
 namespace {
 
-std::string number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "-"; }
+using detail::finite;
+using detail::number;
 
 // (IV - LS) in standard deviations of the difference: how surely this parameter moves.
 double apart(const residual::IvFit& f, Eigen::Index j) {
   const double d = f.value(j) - f.ls_value(j);
   return f.difference_std(j) > 0.0 ? d / f.difference_std(j) : std::nan("");
 }
-
-nlohmann::json finite(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 }  // namespace
 

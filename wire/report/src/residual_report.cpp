@@ -8,11 +8,12 @@
 #include <nlohmann/json.hpp>
 
 #include "dynid/residual/road_profile.hpp"
+#include "cells.hpp"
 
 namespace dynid::report {
 namespace {
 
-std::string number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "-"; }
+using detail::number;
 std::string percent(double v) { return std::isfinite(v) ? fmt::format("{:.2f}", v) : "-"; }
 // A road profile's knot parameter: <profile effect>[@group]@<distance>m. Other names with '@'
 // (a dictionary term's coefficient in one equation group) are listed.
@@ -162,7 +163,7 @@ namespace {
 
 using nlohmann::json;
 
-json finite(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+using detail::finite;
 
 json candidate_json(const residual::CandidateScore& c) {
   return {{"effect", c.effect},

@@ -6,12 +6,14 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "cells.hpp"
+
 namespace dynid::report {
 namespace {
 
-std::string number(double v) { return std::isfinite(v) ? fmt::format("{:.6g}", v) : "-"; }
+using detail::finite;
+using detail::number;
 
-nlohmann::json finite(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 // (SIMEX - LS) in SIMEX's std: how large the correction is against its own uncertainty.
 double correction_z(const residual::SimexFit& f, Eigen::Index j) {
