@@ -60,11 +60,13 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
       s.iv_value = iv.value(k);
       s.iv_std = iv.std(k);
       s.iv_hac_std = iv.hac_std(k);
+      s.iv_difference_std = iv.difference_std(k);
     }
     if (i < simex.parameters.size() && simex.parameters[i].name == name) {
       s.simex_value = simex.value(k);
       s.simex_std = simex.std(k);
       s.simex_mc_std = simex.monte_carlo_std(k);
+      s.simex_level_std = simex.level_std(k);
       s.simex_corrected = simex.corrected();
     }
     s.simex_over_iv = simex_over_iv;

@@ -33,6 +33,7 @@ struct ParameterSample {
   double iv_value = kNaN;   ///< NaN: refused (iv_refused says why) or not identifiable
   double iv_std = kNaN;     ///< textbook s^2 (Z'W)^-1 Z'Z (W'Z)^-1
   double iv_hac_std = kNaN; ///< HAC sandwich
+  double iv_difference_std = kNaN;  ///< HAC std of IV - LS (IvFit::difference_std)
   bool dwh_rejects = false; ///< the model's Durbin-Wu-Hausman test rejects at 1 %
   double iv_instrument_f = kNaN;  ///< the model's Cragg-Donald F (weak-instrument check)
   std::string iv_refused;   ///< the refusal's reason, empty when IV was estimated
@@ -40,6 +41,7 @@ struct ParameterSample {
   double simex_value = kNaN;
   double simex_std = kNaN;     ///< sqrt(LS HAC^2 + Monte Carlo^2 + noise level^2)
   double simex_mc_std = kNaN;  ///< its Monte Carlo part
+  double simex_level_std = kNaN;  ///< its noise-level part
   bool simex_corrected = false;  ///< some channel's noise reaches the rows
   /// Hausman's comparison lets SIMEX stand in for IV (residual::compare_simex_with_iv, the model's
   /// fits as a whole): published in IV's place where DWH rejects least squares.

@@ -44,6 +44,7 @@ residual::IvFit iv_rejecting_least_squares() {
   iv.parameters = parameters();
   iv.value = Eigen::Vector2d(1.02, 2.04);
   iv.hac_std = Eigen::Vector2d(0.02, 0.04);
+  iv.difference_std = Eigen::Vector2d(0.015, 0.03);
   iv.dwh.rejects = true;
   return iv;
 }
@@ -54,9 +55,10 @@ residual::SimexFit simex_at(const Eigen::Vector2d& value) {
   simex.parameters = parameters();
   simex.contributing = {"vx"};
   simex.value = value;
-  simex.std = Eigen::Vector2d(0.01, 0.02);  // the differences' std: sqrt(3) 0.01 and sqrt(3) 0.02
+  simex.std = Eigen::Vector2d(0.01, 0.02);
   simex.ls_value = Eigen::Vector2d(1.0, 2.0);
-  simex.monte_carlo_std = simex.level_std = Eigen::Vector2d(0.001, 0.002);
+  // The differences' std: sqrt(0.015^2 + 2 x 0.002^2) = 0.0153 and sqrt(0.03^2 + 2 x 0.004^2) = 0.0305.
+  simex.monte_carlo_std = simex.level_std = Eigen::Vector2d(0.002, 0.004);
   return simex;
 }
 
@@ -86,7 +88,7 @@ TEST(EstimateTables, SimexAgreeingWithIvTakesIvsRowsWithLeastSquaresBeside) {
 
 TEST(EstimateTables, SimexDisagreeingWithIvLeavesIvsRowsAndSaysWhy) {
   const residual::IvFit iv = iv_rejecting_least_squares();
-  // b: |2.04 - 1.90| / (sqrt(3) 0.02) = 4.0, beyond the 0.5 % bound (2.81).
+  // b: |2.04 - 1.90| / 0.0305 = 4.6, beyond the 0.5 % bound (2.81).
   const dds::EstimateTable table = published(simex_at(Eigen::Vector2d(1.02, 1.90)), &iv);
   EXPECT_EQ(table.estimator, dds::kInstrumentalVariables);
   EXPECT_NE(table.bias_test.find("IV kept"), std::string::npos) << table.bias_test;

@@ -19,7 +19,9 @@ model::ParameterInfo named(const std::string& name) {
   return p;
 }
 
-// Two parameters; IV's HAC std 5 and 10, SIMEX's 3 and 6: the differences' std are 4 and 8.
+// Two parameters; IV's HAC std 5 and 10, SIMEX's 3 and 6 (more precise). IV - LS has std 2.4
+// and 4.8, SIMEX's correction Monte Carlo 1.8 and 3.6 and noise-level 1.6 and 3.2: the
+// differences' std are sqrt(2.4^2 + 1.8^2 + 1.6^2) = 3.4 and 6.8.
 struct Fits {
   IvFit iv;
   SimexFit simex;
@@ -28,8 +30,11 @@ struct Fits {
     iv.parameters = simex.parameters = {named("a"), named("b")};
     iv.value = Eigen::Vector2d(100.0, 200.0);
     iv.hac_std = Eigen::Vector2d(5.0, 10.0);
+    iv.difference_std = Eigen::Vector2d(2.4, 4.8);
     simex.value = Eigen::Vector2d(100.0, 200.0);
     simex.std = Eigen::Vector2d(3.0, 6.0);
+    simex.monte_carlo_std = Eigen::Vector2d(1.8, 3.6);
+    simex.level_std = Eigen::Vector2d(1.6, 3.2);
     simex.contributing = {"steer"};
   }
 };
@@ -39,7 +44,7 @@ constexpr double kBound = 2.807;
 
 TEST(SimexAgainstIv, SimexStandsWhereTheDifferencesAreWithinTheirHausmanStd) {
   Fits f;
-  f.simex.value = Eigen::Vector2d(100.0 + 0.99 * kBound * 4.0, 200.0 - 0.99 * kBound * 8.0);
+  f.simex.value = Eigen::Vector2d(100.0 + 0.99 * kBound * 3.4, 200.0 - 0.99 * kBound * 6.8);
   const SimexAgainstIv c = compare_simex_with_iv(f.iv, f.simex);
   EXPECT_TRUE(c.compared);
   EXPECT_TRUE(c.simex_stands);
@@ -51,7 +56,7 @@ TEST(SimexAgainstIv, SimexStandsWhereTheDifferencesAreWithinTheirHausmanStd) {
 
 TEST(SimexAgainstIv, IvStaysWhereOneDifferenceIsBeyondTheBound) {
   Fits f;
-  f.simex.value(1) = 200.0 + 1.01 * kBound * 8.0;
+  f.simex.value(1) = 200.0 + 1.01 * kBound * 6.8;
   const SimexAgainstIv c = compare_simex_with_iv(f.iv, f.simex);
   EXPECT_TRUE(c.compared);
   EXPECT_FALSE(c.simex_stands);
@@ -62,7 +67,7 @@ TEST(SimexAgainstIv, IvStaysWhereOneDifferenceIsBeyondTheBound) {
 
 TEST(SimexAgainstIv, IvStaysWhereSimexIsNotMorePreciseForAParameter) {
   Fits f;
-  f.simex.std(0) = 5.0;  // equal to IV's: no Hausman variance, nothing gained
+  f.simex.std(0) = 5.0;  // equal to IV's: nothing gained
   const SimexAgainstIv c = compare_simex_with_iv(f.iv, f.simex);
   EXPECT_TRUE(c.compared);
   EXPECT_FALSE(c.simex_stands);
@@ -74,7 +79,7 @@ TEST(SimexAgainstIv, IvStaysWhereSimexIsNotMorePreciseForAParameter) {
 TEST(SimexAgainstIv, AParameterOneOfThemDoesNotEstimateIsLeftOutOfTheFamily) {
   Fits f;
   f.iv.value(1) = kNaN;
-  f.simex.value(0) = 100.0 + 1.01 * 2.576 * 4.0;  // beyond the 1 % bound of one parameter
+  f.simex.value(0) = 100.0 + 1.01 * 2.576 * 3.4;  // beyond the 1 % bound of one parameter
   const SimexAgainstIv c = compare_simex_with_iv(f.iv, f.simex);
   EXPECT_EQ(c.parameters, 1);
   EXPECT_DOUBLE_EQ(c.level, 0.01);
