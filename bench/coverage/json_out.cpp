@@ -16,10 +16,12 @@ nlohmann::json sample_json(const ParameterSample& s) {
   return {{"model", s.model},         {"parameter", s.parameter}, {"truth", number(s.truth)},
           {"value", number(s.value)}, {"std", number(s.std)},     {"hac_value", number(s.hac_value)},
           {"hac_std", number(s.hac_std)},     {"iv_value", number(s.iv_value)}, {"iv_std", number(s.iv_std)},
-          {"iv_hac_std", number(s.iv_hac_std)}, {"iv_difference_std", number(s.iv_difference_std)}, {"dwh_rejects", s.dwh_rejects}, {"iv_refused", s.iv_refused},
+          {"iv_hac_std", number(s.iv_hac_std)}, {"iv_difference_std", number(s.iv_difference_std)},
+          {"dwh_rejects", s.dwh_rejects},     {"iv_refused", s.iv_refused},
           {"iv_instrument_f", number(s.iv_instrument_f)}, {"simex_value", number(s.simex_value)},
-          {"simex_std", number(s.simex_std)}, {"simex_mc_std", number(s.simex_mc_std)}, {"simex_level_std", number(s.simex_level_std)},
-          {"simex_corrected", s.simex_corrected},           {"simex_over_iv", s.simex_over_iv}};
+          {"simex_std", number(s.simex_std)}, {"simex_mc_std", number(s.simex_mc_std)},
+          {"simex_level_std", number(s.simex_level_std)}, {"simex_corrected", s.simex_corrected},
+          {"simex_over_iv", s.simex_over_iv}};
 }
 
 nlohmann::json run_json(const SeedRun& r) {

@@ -211,7 +211,7 @@ TEST(E2eResidualCli, TheLiveVerdictIsPublishedBesideTheEstimates) {
     EXPECT_EQ(table["estimator"], "SIMEX") << bias_test;
   else if (bias_test.rfind("least squares is biased", 0) == 0)
     EXPECT_EQ(table["estimator"], "instrumental variables") << bias_test;
-  else  // least squares, or where the measured noise's correction lowers the error, SIMEX
+  else  // least squares, or SIMEX where the measured noise reaches the rows
     EXPECT_NE(table["estimator"], "instrumental variables") << bias_test;
 }
 
