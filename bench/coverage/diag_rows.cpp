@@ -6,6 +6,7 @@
 //   truth-raw     the truth on the grid, no filter, central differences at the grid rate
 //   truth-raw-1k  the truth on the grid, no filter, derivatives from the 1 kHz truth
 // Bias of the weighted LS = (W'PW)^-1 W'P r(theta_true); the per-row contribution to it is printed.
+// Also each channel's measured noise (with --noise 1: against the sigma bench/trace/car/sensors.cpp draws).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +23,7 @@
 #include "car/declared_fit.hpp"
 #include "car/product_path.hpp"
 #include "dynid/model/registry.hpp"
+#include "dynid/residual/noise_floor.hpp"
 #include "dynid/signal/butterworth.hpp"
 #include "dynid/signal/derivative.hpp"
 #include "dynid/signal/zero_phase_filter.hpp"
@@ -46,7 +48,7 @@ Stacked stack(const model::Model& m, const std::vector<std::string>& effects,
   for (const auto& seg : segs) {
     std::vector<Eigen::Index> idx;
     for (Eigen::Index i = 0; i < seg.channels.samples(); ++i)
-      if (ingest::on_decimation_grid(seg, i, odmf)) idx.push_back(i);
+      if (ingest::row_at(seg, i, odmf)) idx.push_back(i);
     for (const auto& g : m.rows_at(seg.channels, idx, effects)) {
       const double w = weight.count(g.group) ? weight.at(g.group) : 1.0;
       for (Eigen::Index r = 0; r < g.W.rows(); ++r) {
@@ -188,6 +190,9 @@ int main(int argc, char** argv) {
   std::printf("preprocessing: order %d cutoff %.3f Hz odmf %d; run first sample %llu, %ld samples\n",
               rec.announcement.preprocessing.butterworth_order, rec.announcement.preprocessing.cutoff(rate), odmf,
               static_cast<unsigned long long>(rec.first_sample_index), static_cast<long>(rec.samples.rows()));
+  // What SIMEX and the noise floor take as each channel's noise (against the car's sensors.cpp).
+  for (const auto& c : residual::measure_channel_noise(rec, run.segments, {}))
+    std::printf("noise %-22s sigma %.5g (%s)\n", c.channel.c_str(), c.sigma, c.source.c_str());
   const ingest::ModelSpec spec = benchcar::model_spec(profile, model_name);
   const auto mdl = model::make_model(spec.model, spec.constants);
   const auto params = mdl->parameters_with(spec.effects);

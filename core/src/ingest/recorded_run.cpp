@@ -82,6 +82,7 @@ std::vector<PreprocessedSegment> preprocess_offline(const RecordedRun& run) {
   const signal::Sos sos = signal::butterworth_lowpass(
       a.preprocessing.butterworth_order, a.preprocessing.cutoff(a.sample_rate_hz), a.sample_rate_hz);
   const Eigen::Index padlen = signal::zero_phase_padlen(sos);
+  const Eigen::Index edge = a.preprocessing.edge_samples(a.sample_rate_hz);
   const auto n = static_cast<Eigen::Index>(run.valid.size());
   std::vector<PreprocessedSegment> out;
   for (Eigen::Index s = 0; s < n;) {
@@ -91,7 +92,10 @@ std::vector<PreprocessedSegment> preprocess_offline(const RecordedRun& run) {
     }
     Eigen::Index e = s;
     while (e < n && run.valid[static_cast<std::size_t>(e)] != 0) ++e;
-    if (e - s > padlen) out.push_back(preprocess_segment(run, sos, s, e - s));
+    if (e - s > padlen) {
+      out.push_back(preprocess_segment(run, sos, s, e - s));
+      out.back().edge = edge;
+    }
     s = e;
   }
   return out;

@@ -7,6 +7,7 @@
 #include "dynid/error.hpp"
 #include "dynid/input/ids.hpp"
 #include "dynid/signal/butterworth.hpp"
+#include "dynid/signal/zero_phase_filter.hpp"
 
 namespace dynid::ingest {
 namespace {
@@ -62,6 +63,12 @@ void validate_models(const RunAnnouncement& a) {
 double Preprocessing::cutoff(double sample_rate_hz) const {
   if (cutoff_hz != 0.0) return cutoff_hz;
   return signal::dycaro_cutoff(sample_rate_hz, odmf);
+}
+
+Eigen::Index Preprocessing::edge_samples(double sample_rate_hz) const {
+  const signal::Sos sos =
+      signal::butterworth_lowpass(butterworth_order, cutoff(sample_rate_hz), sample_rate_hz);
+  return signal::zero_phase_edge_reach(sos, kEdgeOutsideShare);
 }
 
 void RunAnnouncement::validate() const {

@@ -1,6 +1,7 @@
 #include "dynid/ingest/run_processor.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <set>
 
 #include "byte_codec.hpp"
@@ -16,7 +17,7 @@ namespace dynid::ingest {
 namespace {
 
 constexpr std::string_view kMagic = "DYNIDRPC";
-constexpr std::uint16_t kVersion = 1;
+constexpr std::uint16_t kVersion = 2;  // 2: rows outside the edge reach, the five-point derivative
 
 struct ModelRun {
   ModelSpec spec;
@@ -90,6 +91,7 @@ struct RunProcessor::Impl {
   detail::Layout layout;
   std::vector<ModelRun> models;
   model::RowReach reach;
+  Eigen::Index edge = 0;  // no row this near a segment's ends (Preprocessing::edge_samples)
   std::optional<detail::SegmentStream> segment;
   RunCounters counters;
   std::uint64_t next_sequence = 0;
@@ -131,6 +133,10 @@ RunProcessor::Impl::Impl(RunAnnouncement a, ChunkLimits l)
     reach.back = std::max(reach.back, r.back);
     reach.ahead = std::max(reach.ahead, r.ahead);
   }
+  // A row is built once `edge` later samples of its segment are in (or the segment ended): only
+  // then is it known not to lie within the filter's edge reach of the segment's end.
+  edge = announcement.preprocessing.edge_samples(announcement.sample_rate_hz);
+  reach.ahead = std::max(reach.ahead, edge);
   segment.emplace(sos, layout, period, announcement.preprocessing.filter_tolerance, reach);
   plan_models();
 }
@@ -202,11 +208,17 @@ void RunProcessor::Impl::collect(detail::SegmentStream& seg, bool at_end, RunCou
   if (ready.new_count == 0) return;
   // The samples of the context (already folded) and of the look-ahead (not final) are left
   // out, and so are those off the decimation grid: the run's grid index decides, not where a
-  // chunk or a filter block begins. Rows are built at the kept samples only.
+  // chunk or a filter block begins; and those within the filter's edge reach of the segment's
+  // ends (before the end, ready() holds back reach.ahead >= edge samples). Rows are built at the
+  // kept samples only, as ingest::row_at() keeps them offline.
   std::vector<Eigen::Index> grid;
   const std::uint64_t first = seg.start_index() + static_cast<std::uint64_t>(ready.first_index);
-  for (Eigen::Index k = ready.first_new; k < ready.first_new + ready.new_count; ++k)
-    if ((first + static_cast<std::uint64_t>(k)) % decimation == 0) grid.push_back(k);
+  const Eigen::Index last = at_end ? seg.length() - edge : std::numeric_limits<Eigen::Index>::max();
+  for (Eigen::Index k = ready.first_new; k < ready.first_new + ready.new_count; ++k) {
+    const Eigen::Index in_segment = ready.first_index + k;
+    if ((first + static_cast<std::uint64_t>(k)) % decimation == 0 && in_segment >= edge && in_segment < last)
+      grid.push_back(k);
+  }
   if (!grid.empty()) {
     const model::ChannelSet set = channel_set(ready.rows);
     for (std::size_t m = 0; m < models.size(); ++m)

@@ -69,7 +69,7 @@ namespace {
 std::vector<Eigen::Index> decimation_grid(const ingest::PreprocessedSegment& seg, int odmf) {
   std::vector<Eigen::Index> kept;  // rows are built at the decimation grid's samples only
   for (Eigen::Index i = 0; i < seg.channels.samples(); ++i)
-    if (ingest::on_decimation_grid(seg, i, odmf)) kept.push_back(i);
+    if (ingest::row_at(seg, i, odmf)) kept.push_back(i);
   return kept;
 }
 

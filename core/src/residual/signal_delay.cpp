@@ -72,7 +72,7 @@ std::vector<ingest::PreprocessedSegment> delayed(const std::vector<ingest::Prepr
       throw InputError("effect 'delay:" + d.channel + "': the run has no channel '" + d.channel + "'");
   std::vector<ingest::PreprocessedSegment> out;
   out.reserve(run.size());
-  for (const ingest::PreprocessedSegment& s : run) out.push_back({s.first, delayed_set(s.channels, delays)});
+  for (const ingest::PreprocessedSegment& s : run) out.push_back({s.first, delayed_set(s.channels, delays), s.edge});
   return out;
 }
 

@@ -1,7 +1,9 @@
 #include "dynid/signal/zero_phase_filter.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "cascade.hpp"
 #include "checks.hpp"
@@ -44,6 +46,49 @@ Eigen::MatrixXd zero_phase_filter(const Sos& sos, const Eigen::MatrixXd& x) {
     y.col(c) = ext.segment(padlen, n);
   }
   return y;
+}
+
+namespace {
+
+// |g[j]| for j = 0, 1, ... of the zero-phase impulse response g (symmetric: g[-j] = g[j]), long
+// enough that what is cut off is below 1e-15 of the l1 mass: the forward pass of an impulse in
+// the middle of 2 n + 1 zeros, then the backward pass, from rest, doubling n until the tail at
+// both ends is negligible (the stable poles make it decay geometrically).
+std::vector<double> zero_phase_impulse_magnitudes(const Sos& sos) {
+  for (Eigen::Index half = 64;; half *= 2) {
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(2 * half + 1);
+    x(half) = 1.0;
+    Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * sos.size());
+    detail::run_forward(sos, z.data(), x.data(), x.size());
+    z.setZero();
+    detail::run_backward(sos, z.data(), x.data(), x.size());
+    const double mass = x.cwiseAbs().sum();
+    const Eigen::Index edge = half / 8;
+    const double cut = x.head(edge).cwiseAbs().sum() + x.tail(edge).cwiseAbs().sum();
+    if (cut <= 1e-15 * mass || half > (Eigen::Index{1} << 24)) {
+      std::vector<double> out(static_cast<std::size_t>(half + 1));
+      for (Eigen::Index j = 0; j <= half; ++j) out[static_cast<std::size_t>(j)] = std::abs(x(half + j));
+      return out;
+    }
+  }
+}
+
+}  // namespace
+
+Eigen::Index zero_phase_edge_reach(const Sos& sos, double outside_share) {
+  if (!(outside_share > 0.0 && outside_share < 0.5))
+    throw InputError("zero_phase_edge_reach: outside share " + std::to_string(outside_share) +
+                     " is outside (0, 0.5)");
+  const std::vector<double> g = zero_phase_impulse_magnitudes(sos);
+  double mass = g[0];
+  for (std::size_t j = 1; j < g.size(); ++j) mass += 2.0 * g[j];
+  // beyond = the mass of g[j] for j > d, on one side: what lies past an end d samples away.
+  double beyond = mass - g[0];
+  beyond *= 0.5;
+  Eigen::Index d = 0;
+  for (; static_cast<std::size_t>(d + 1) < g.size() && beyond > outside_share * mass; ++d)
+    beyond -= g[static_cast<std::size_t>(d + 1)];
+  return d;
 }
 
 }  // namespace dynid::signal

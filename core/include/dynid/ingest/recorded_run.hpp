@@ -15,8 +15,9 @@
 // filter are left out, as RunProcessor leaves them out. The streamed path equals this one to the
 // announcement's filter tolerance (tests/ingest: "MatchesTheFullyOfflinePath...").
 //
-// Rows are decimated by the caller: a row at segment sample i is kept when
-// (segment.first + i) % odmf == 0 (on_decimation_grid()).
+// Rows are decimated by the caller: a row at segment sample i is built when
+// (segment.first + i) % odmf == 0 and i is at least segment.edge samples from both ends of the
+// segment (row_at(); Preprocessing::edge_samples()).
 #include <cstdint>
 #include <vector>
 
@@ -41,6 +42,7 @@ RecordedRun assemble_run(RunAnnouncement announcement, const std::vector<Chunk>&
 struct PreprocessedSegment {
   Eigen::Index first = 0;  ///< run grid index of the segment's first sample
   model::ChannelSet channels;
+  Eigen::Index edge = 0;  ///< no row within this many samples of either end (the filter's edges)
 };
 
 std::vector<PreprocessedSegment> preprocess_offline(const RecordedRun& run);
@@ -54,9 +56,11 @@ std::vector<PreprocessedSegment> preprocess_channel_again(const RecordedRun& run
                                                           std::vector<PreprocessedSegment> segments,
                                                           Eigen::Index column);
 
-/// True when the row at segment sample `i` lies on the run's decimation grid.
-inline bool on_decimation_grid(const PreprocessedSegment& segment, Eigen::Index i, int odmf) {
-  return (segment.first + i) % odmf == 0;
+/// True when a row is built at segment sample `i`: it lies on the run's decimation grid and at
+/// least segment.edge samples from both ends of the segment.
+inline bool row_at(const PreprocessedSegment& segment, Eigen::Index i, int odmf) {
+  return (segment.first + i) % odmf == 0 && i >= segment.edge &&
+         i < segment.channels.samples() - segment.edge;
 }
 
 }  // namespace dynid::ingest

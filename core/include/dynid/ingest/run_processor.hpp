@@ -15,9 +15,11 @@
 // Segments. A gap (valid == 0) ends the current valid segment; the next valid sample starts a
 // new one with a fresh filter. Each segment is processed as the offline filter processes a whole
 // record: odd extension and steady-state starts at both of its ends (zero_phase_filter.hpp),
-// one-sided second-order differences at its first and last samples (derivative.hpp), and model
+// one-sided second-order differences at its first and last samples (derivative.hpp), model
 // rows whose lags or look-ahead reach outside the segment are left out, as at a run's ends
-// (effects.hpp). Nothing is ever filtered across a gap. A segment of at most padlen samples
+// (effects.hpp), and so are the rows within the filter's edge reach of either end
+// (Preprocessing::edge_samples: there the filtered samples are partly the edge extension).
+// Nothing is ever filtered across a gap. A segment of at most padlen samples
 // (too short for the edge extension) is skipped and counted (RunCounters::short_segments).
 //
 // Invariance. The result does not depend on how the run is cut into chunks: the streaming
@@ -28,8 +30,8 @@
 // depends on the grid index only. Only the grouping of rows into accumulator folds differs,
 // i.e. the estimates agree to rounding (extended-precision accumulators: ~1e-15 relative).
 //
-// Delay: a sample's rows are folded once about filter delay() + 1 + the models' look-ahead
-// later samples are in (the derivative's and the rows' look-ahead); finish() folds the rest.
+// Delay: a sample's rows are folded once about filter delay() + 1 + the larger of the models'
+// look-ahead and the edge reach later samples are in; finish() folds the rest.
 //
 // Checkpoints. checkpoint() is the complete state (accumulators, filter and derivative buffers,
 // the row window, counters, sequence), versioned and checksummed; restore() under the same
@@ -61,11 +63,12 @@
 
 namespace dynid::ingest {
 
-/// Least row context around a sample: the dictionary's lags (3 back) and look-ahead (central
-/// difference, locked driveline's neighbour test: 1 ahead); a model that reads further says so
-/// (model::Model::reach()) and gets more.
+/// Least row context around a sample: the dictionary's lags (3 back) and look-ahead (its
+/// five-point difference: 2 ahead; locked driveline's neighbour test: 1); a model that reads
+/// further says so (model::Model::reach()) and gets more. (The edge reach, Preprocessing::
+/// edge_samples, is a look-ahead too: rows are built once it is in.)
 inline constexpr Eigen::Index kReachBack = 3;
-inline constexpr Eigen::Index kReachAhead = 1;
+inline constexpr Eigen::Index kReachAhead = 2;
 
 struct RunCounters {
   std::uint64_t chunks = 0;           ///< chunks accepted

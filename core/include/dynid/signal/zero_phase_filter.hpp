@@ -25,4 +25,14 @@ Eigen::Index zero_phase_padlen(const Sos& sos);
 // infinite (naming the channel and the sample index).
 Eigen::MatrixXd zero_phase_filter(const Sos& sos, const Eigen::MatrixXd& x);
 
+// How far the edges reach into a filtered signal: the smallest d >= 0 such that, for a sample d
+// or more samples inside an end, at most `outside_share` of the zero-phase impulse response's
+// l1 mass (|H|^2's response, centred on the sample) falls beyond that end. Closer to an end, more
+// of the sample's value comes from the odd extension and the steady-state starts instead of the
+// signal, and the error this makes is not noise: it follows the signal's curvature at the end,
+// the same in every repetition of a run (what a model row must not carry). outside_share in
+// (0, 0.5); InputError otherwise. For the 5th-order low-pass at 0.05 of the sample rate and
+// outside_share 0.01: 42 samples (2.1 / cut-off).
+Eigen::Index zero_phase_edge_reach(const Sos& sos, double outside_share);
+
 }  // namespace dynid::signal
