@@ -71,17 +71,16 @@ TEST(Effects, DictionaryColumnsByHand) {
       m->rows(set, {"dict:x:vx", "dict:sq:vx", "dict:absx:vx", "dict:sgn:vx", "dict:d:vx",
                     "dict:lag2:vx"})
           .front();
-  // lag2 needs k >= 2, d needs k + 1 < 6, braking masks 2: rows 3 and 4 remain.
-  EXPECT_EQ(g.samples, (std::vector<Eigen::Index>{3, 4}));
-  const auto r = static_cast<Eigen::Index>(row_of(g, 4));
-  EXPECT_DOUBLE_EQ(g.W(r, 3), 17.0);
-  EXPECT_DOUBLE_EQ(g.W(r, 4), 289.0);
-  EXPECT_DOUBLE_EQ(g.W(r, 5), 289.0);
+  // lag2 needs k >= 2, d (five-point) 2 <= k and k + 2 < 6, braking masks 2: row 3 remains.
+  EXPECT_EQ(g.samples, (std::vector<Eigen::Index>{3}));
+  const auto r = static_cast<Eigen::Index>(row_of(g, 3));
+  EXPECT_DOUBLE_EQ(g.W(r, 3), 15.0);
+  EXPECT_DOUBLE_EQ(g.W(r, 4), 225.0);
+  EXPECT_DOUBLE_EQ(g.W(r, 5), 225.0);
   EXPECT_DOUBLE_EQ(g.W(r, 6), 1.0);
-  EXPECT_DOUBLE_EQ(g.W(r, 7), (20.0 - 15.0) / 0.2);
-  EXPECT_DOUBLE_EQ(g.W(r, 8), 14.0);
-  const auto r3 = static_cast<Eigen::Index>(row_of(g, 3));
-  EXPECT_DOUBLE_EQ(g.W(r3, 5), 225.0);
+  // vx[1] - 8 vx[2] + 8 vx[4] - vx[5] over 12 T: the preprocessing's d_vx stencil.
+  EXPECT_DOUBLE_EQ(g.W(r, 7), (-12.0 - 8.0 * 14.0 + 8.0 * 17.0 - 20.0) / (12.0 * 0.1));
+  EXPECT_DOUBLE_EQ(g.W(r, 8), -12.0);
 }
 
 // An interaction of two channels (issue 15): dict:prod:<a>*<b> is a b, read from both channels,

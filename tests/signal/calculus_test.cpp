@@ -1,6 +1,7 @@
 // Central differences, trapezoidal integration and decimation, offline and over chunks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -23,14 +24,34 @@ Eigen::VectorXd times(Eigen::Index n, double period, double start) {
   return t;
 }
 
-TEST(Derivative, CentralDifferenceOfSineHasGainSinWtOverWt) {
+// Inside, the five-point stencil's gain on sin(w t) is (8 sin(wT) - sin(2 wT)) / (6 wT); next to
+// the ends, the three-point one's sin(wT) / (wT).
+TEST(Derivative, CentralDifferenceOfSineHasTheStencilsGain) {
   const double period = 0.01;
   const double w = 2.0 * std::numbers::pi * 1.3;
   const Eigen::VectorXd t = times(500, period, 0.2);
   const Eigen::VectorXd x = (w * t.array()).sin();
   const Eigen::VectorXd dx = derivative(x, period);
-  for (Eigen::Index k = 1; k + 1 < t.size(); ++k)
-    EXPECT_NEAR(dx(k), std::sin(w * period) / period * std::cos(w * t(k)), 1e-12 * w) << k;
+  const double wt = w * period;
+  const double five_point = (8.0 * std::sin(wt) - std::sin(2.0 * wt)) / (6.0 * period);
+  for (Eigen::Index k = 2; k + 2 < t.size(); ++k)
+    EXPECT_NEAR(dx(k), five_point * std::cos(w * t(k)), 1e-12 * w) << k;
+  for (Eigen::Index k : {Eigen::Index{1}, t.size() - 2})
+    EXPECT_NEAR(dx(k), std::sin(wt) / period * std::cos(w * t(k)), 1e-12 * w) << k;
+  // At 5 Hz and 100 Hz (the default cut-off) the five-point gain is within 4e-4 of 1, the
+  // three-point one 1.6 % below it.
+  const double at_cutoff = 2.0 * std::numbers::pi * 5.0 * period;
+  EXPECT_NEAR((8.0 * std::sin(at_cutoff) - std::sin(2.0 * at_cutoff)) / (6.0 * at_cutoff), 1.0, 4e-4);
+  EXPECT_NEAR(std::sin(at_cutoff) / at_cutoff, 0.984, 1e-3);
+}
+
+TEST(Derivative, ExactOnQuarticsInside) {
+  const double period = 0.02;
+  const Eigen::VectorXd t = times(60, period, -0.5);
+  const Eigen::VectorXd x = 1.0 + t.array() - 2.0 * t.array().pow(3) + 0.5 * t.array().pow(4);
+  const Eigen::VectorXd dx = derivative(x, period);
+  for (Eigen::Index k = 2; k + 2 < t.size(); ++k)
+    EXPECT_NEAR(dx(k), 1.0 - 6.0 * t(k) * t(k) + 2.0 * std::pow(t(k), 3), 1e-11) << k;
 }
 
 TEST(Derivative, ExactOnQuadraticsEndsIncluded) {
@@ -46,7 +67,7 @@ TEST(Derivative, ExactOnQuadraticsEndsIncluded) {
   }
 }
 
-TEST(Derivative, StreamingHasOneSampleLookAheadAndEqualsOffline) {
+TEST(Derivative, StreamingHasTwoSamplesLookAheadAndEqualsOffline) {
   const Eigen::MatrixXd x = test::test_signal(300, 2, 21u);
   const Eigen::MatrixXd offline = derivative(x, 0.002);
   for (Eigen::Index size : {1, 2, 7, 300}) {
@@ -58,9 +79,10 @@ TEST(Derivative, StreamingHasOneSampleLookAheadAndEqualsOffline) {
       const Eigen::MatrixXd got = d.push(x.middleRows(in, m));
       y.middleRows(out, got.rows()) = got;
       out += got.rows();
-      EXPECT_EQ(out, in + m >= 3 ? in + m - 1 : 0);  // x'[k] out once x[k+1] is in
+      // x'[0] and x'[1] out once x[2] is in, x'[k >= 2] once x[k+2] is
+      EXPECT_EQ(out, in + m >= 3 ? std::max<Eigen::Index>(2, in + m - 2) : 0);
     }
-    y.bottomRows(1) = d.finish();
+    y.bottomRows(2) = d.finish();
     EXPECT_EQ(y, offline) << "chunk size " << size;
   }
 }
@@ -68,7 +90,7 @@ TEST(Derivative, StreamingHasOneSampleLookAheadAndEqualsOffline) {
 TEST(Derivative, StreamingStateRestoresExactlyAndIsChecked) {
   const Eigen::MatrixXd x = test::test_signal(50, 2, 22u);
   const Eigen::MatrixXd offline = derivative(x, 0.01);
-  for (Eigen::Index cut : {0, 1, 2, 3, 20}) {
+  for (Eigen::Index cut : {0, 1, 2, 3, 4, 5, 20}) {
     StreamingDerivative first(2, 0.01);
     Eigen::MatrixXd y(x.rows(), 2);
     const Eigen::MatrixXd a = first.push(x.topRows(cut));
@@ -84,7 +106,7 @@ TEST(Derivative, StreamingStateRestoresExactlyAndIsChecked) {
   bad.samples_out = 3;
   EXPECT_THROW(d.restore(bad), InputError);
   EXPECT_THROW(StreamingDerivative(3, 0.01).restore(d.state()), InputError);
-  EXPECT_EQ(d.samples_out(), 9);
+  EXPECT_EQ(d.samples_out(), 8);
 }
 
 TEST(Derivative, RejectsShortOrNonFiniteInput) {
@@ -99,7 +121,10 @@ TEST(Derivative, RejectsShortOrNonFiniteInput) {
   test::expect_input_error([&] { (void)d.push(bad); }, "channel 0, sample 5 is NaN");
   EXPECT_EQ(d.samples_in(), 2);
   EXPECT_EQ(d.push(Eigen::VectorXd::Constant(1, 4.0)).rows(), 2);
-  EXPECT_EQ(d.finish().rows(), 1);
+  EXPECT_EQ(d.finish().rows(), 1);  // 3 samples: x'[0], x'[1] out, x'[2] one-sided
+  StreamingDerivative four(1, 0.01);
+  EXPECT_EQ(four.push(Eigen::VectorXd::Ones(4)).rows(), 2);
+  EXPECT_EQ(four.finish().rows(), 2);  // x'[2] three-point, x'[3] one-sided
 }
 
 TEST(Trapezoid, ExactOnLinearFunctions) {

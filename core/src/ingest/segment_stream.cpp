@@ -100,9 +100,9 @@ void SegmentStream::push(const Eigen::Ref<const Eigen::MatrixXd>& raw) {
 void SegmentStream::finish() {
   append_final(filter_.finish());
   if (!now_.derivative) return;
-  const Eigen::MatrixXd last = now_.derivative->finish();
-  now_.window.row(now_.derived_end - now_.window_first).tail(last.cols()) = last.row(0);
-  ++now_.derived_end;
+  const Eigen::MatrixXd last = now_.derivative->finish();  // the last one or two samples'
+  now_.window.block(now_.derived_end - now_.window_first, layout_.announced, last.rows(), last.cols()) = last;
+  now_.derived_end += last.rows();
 }
 
 void SegmentStream::append_final(const Eigen::MatrixXd& filtered) {

@@ -5,6 +5,7 @@
 
 #include "dictionary.hpp"
 #include "dynid/error.hpp"
+#include "dynid/signal/derivative.hpp"
 
 namespace dynid::model {
 namespace {
@@ -20,7 +21,7 @@ constexpr std::array<Op, 9> kOps{{{"x", "x", 0, 0},
                                   {"sq", "x^2", 0, 0},
                                   {"absx", "|x| x", 0, 0},
                                   {"sgn", "sgn x", 0, 0},
-                                  {"d", "dx/dt (central difference)", 1, 1},
+                                  {"d", "dx/dt (the preprocessing's five-point central difference)", 2, 2},
                                   {"lag1", "x delayed by 1 sample", 1, 0},
                                   {"lag2", "x delayed by 2 samples", 2, 0},
                                   {"lag3", "x delayed by 3 samples", 3, 0},
@@ -68,7 +69,7 @@ double apply(const Op* op, const Eigen::VectorXd& x, const Eigen::VectorXd* y, E
     case 1: return x(k) * x(k);
     case 2: return std::abs(x(k)) * x(k);
     case 3: return sgn(x(k));
-    case 4: return (x(k + 1) - x(k - 1)) / (2.0 * period);
+    case 4: return signal::inside_derivative(x, k, period);  // as d_<channel>, so the same column
     case 8: return x(k) * (*y)(k);
     default: return x(k - op->back);  // lagL
   }

@@ -22,6 +22,19 @@ void StreamingDerivative::reset() {
   finished_ = false;
 }
 
+namespace {
+
+// Samples held between pushes: x'[k] needs x[k-2] .. x[k+2], and the next k is samples_in - 2.
+constexpr Eigen::Index kHeld = 4;
+
+// How many x'[k] are final once `samples_in` samples are in (before finish()): x'[0] (one-sided)
+// and x'[1] (three-point) once x[2] is in, x'[k >= 2] (five-point) once x[k + 2] is in.
+Eigen::Index final_before_finish(Eigen::Index samples_in) {
+  return samples_in >= 3 ? std::max<Eigen::Index>(2, samples_in - 2) : 0;
+}
+
+}  // namespace
+
 Eigen::MatrixXd StreamingDerivative::push(const Eigen::MatrixXd& chunk) {
   const char* what = "StreamingDerivative::push";
   if (finished_) throw InputError(std::string(what) + ": the signal was finished; reset() first");
@@ -32,27 +45,30 @@ Eigen::MatrixXd StreamingDerivative::push(const Eigen::MatrixXd& chunk) {
   w << recent_, chunk;
   const Eigen::Index first = n_in_ - recent_.rows();
   n_in_ += chunk.rows();
-  const Eigen::Index final_count = n_in_ >= 3 ? n_in_ - 1 : 0;  // x'[k] final once x[k+1] is in
+  const Eigen::Index final_count = final_before_finish(n_in_);
   Eigen::MatrixXd out(final_count - n_out_, channels_);
   const double half = 0.5 / period_;
+  const double twelfth = 1.0 / (12.0 * period_);
   for (Eigen::Index k = n_out_; k < final_count; ++k) {
     const Eigen::Index i = k - first;
     if (k == 0)
       out.row(0) = (-3.0 * w.row(i) + 4.0 * w.row(i + 1) - w.row(i + 2)) * half;
-    else
+    else if (k == 1)
       out.row(k - n_out_) = (w.row(i + 1) - w.row(i - 1)) * half;
+    else
+      out.row(k - n_out_) =
+          (w.row(i - 2) - 8.0 * w.row(i - 1) + 8.0 * w.row(i + 1) - w.row(i + 2)) * twelfth;
   }
   n_out_ = final_count;
-  recent_ = w.bottomRows(std::min<Eigen::Index>(3, w.rows()));
+  recent_ = w.bottomRows(std::min<Eigen::Index>(kHeld, w.rows()));
   return out;
 }
 
 void StreamingDerivative::restore(const State& s) {
-  const Eigen::Index pushed_out = s.samples_in >= 3 ? s.samples_in - 1 : 0;
+  const Eigen::Index out = s.finished ? s.samples_in : final_before_finish(s.samples_in);
   const bool fits = s.samples_in >= 0 && s.recent.cols() == channels_ &&
-                    s.recent.rows() == std::min<Eigen::Index>(3, s.samples_in) &&
-                    s.samples_out == pushed_out + (s.finished ? 1 : 0) &&
-                    (!s.finished || s.samples_in >= 3) && s.recent.allFinite();
+                    s.recent.rows() == std::min<Eigen::Index>(kHeld, s.samples_in) &&
+                    s.samples_out == out && (!s.finished || s.samples_in >= 3) && s.recent.allFinite();
   if (!fits)
     throw InputError("StreamingDerivative::restore: the state does not fit (" +
                      std::to_string(channels_) + " channels; counts, shape or values)");
@@ -68,9 +84,14 @@ Eigen::MatrixXd StreamingDerivative::finish() {
   if (n_in_ < 3)
     throw InputError(std::string(what) + ": the signal has " + std::to_string(n_in_) +
                      " samples; a second-order derivative needs at least 3");
-  const auto& r = recent_;  // x[n-3], x[n-2], x[n-1]
-  Eigen::MatrixXd out = (3.0 * r.row(2) - 4.0 * r.row(1) + r.row(0)) * (0.5 / period_);
-  ++n_out_;
+  const Eigen::Index h = recent_.rows();
+  const auto last = [&](Eigen::Index back) { return recent_.row(h - 1 - back); };  // x[n-1-back]
+  const double half = 0.5 / period_;
+  // x'[n-2] (three-point) unless it is x'[1], out already; then x'[n-1] (one-sided).
+  Eigen::MatrixXd out(n_in_ - n_out_, channels_);
+  if (n_out_ == n_in_ - 2) out.row(0) = (last(0) - last(2)) * half;
+  out.bottomRows(1) = (3.0 * last(0) - 4.0 * last(1) + last(2)) * half;
+  n_out_ = n_in_;
   finished_ = true;
   return out;
 }
@@ -83,8 +104,9 @@ Eigen::MatrixXd derivative(const Eigen::MatrixXd& x, double sample_period) {
   if (x.cols() == 0) return Eigen::MatrixXd(x.rows(), 0);
   StreamingDerivative d(x.cols(), sample_period);
   Eigen::MatrixXd y(x.rows(), x.cols());
-  y.topRows(x.rows() - 1) = d.push(x);
-  y.bottomRows(1) = d.finish();
+  const Eigen::MatrixXd pushed = d.push(x);
+  y.topRows(pushed.rows()) = pushed;
+  y.bottomRows(x.rows() - pushed.rows()) = d.finish();
   return y;
 }
 
