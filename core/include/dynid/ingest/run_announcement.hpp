@@ -69,8 +69,9 @@ struct Preprocessing {
   /// Rows are built only at samples this far or farther from both ends of their valid segment:
   /// the filter's edge reach (signal::zero_phase_edge_reach) at kEdgeOutsideShare. Nearer an
   /// end, a filtered sample is partly made of the edge extension, an error that follows the
-  /// signal's curvature there and repeats with the run (0.4-0.7 % on the drag area of a noise-free
-  /// run that ends accelerating). About 2 / cut-off: 0.4 s at 5 Hz.
+  /// signal's curvature there and repeats with the run (the second car's engine model on its
+  /// simulated true channels, seed 1001: drag area +0.72 % with those rows, +0.11 % without;
+  /// dynid-diag-rows). 1.75 / cut-off for the 5th order: 0.35 s at 5 Hz.
   Eigen::Index edge_samples(double sample_rate_hz) const;
 };
 

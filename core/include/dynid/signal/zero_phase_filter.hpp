@@ -32,7 +32,7 @@ Eigen::MatrixXd zero_phase_filter(const Sos& sos, const Eigen::MatrixXd& x);
 // signal, and the error this makes is not noise: it follows the signal's curvature at the end,
 // the same in every repetition of a run (what a model row must not carry). outside_share in
 // (0, 0.5); InputError otherwise. For the 5th-order low-pass at 0.05 of the sample rate and
-// outside_share 0.01: 42 samples (2.1 / cut-off).
+// outside_share 0.01: 35 samples (1.75 / cut-off).
 Eigen::Index zero_phase_edge_reach(const Sos& sos, double outside_share);
 
 }  // namespace dynid::signal
