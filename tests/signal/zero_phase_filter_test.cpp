@@ -139,6 +139,10 @@ TEST(ZeroPhaseFilter, EdgeReachLeavesAtMostTheShareBeyondAnEnd) {
   EXPECT_GT(zero_phase_edge_reach(butterworth_lowpass(5, 2.0, 100.0), 0.01), zero_phase_edge_reach(sos, 0.01));
   EXPECT_GT(zero_phase_edge_reach(sos, 0.001), zero_phase_edge_reach(sos, 0.01));
   test::expect_input_error([&] { (void)zero_phase_edge_reach(sos, 0.0); }, "outside share");
+  // A cut-off of 1e-6 of the sample rate (an announcement may carry one): refused, not searched
+  // over tens of millions of samples.
+  test::expect_input_error([&] { (void)zero_phase_edge_reach(butterworth_lowpass(5, 1e-4, 100.0), 0.01); },
+                           "has not decayed");
   test::expect_input_error([&] { (void)zero_phase_edge_reach(sos, 0.5); }, "outside share");
 }
 

@@ -31,7 +31,8 @@ Eigen::MatrixXd zero_phase_filter(const Sos& sos, const Eigen::MatrixXd& x);
 // of the sample's value comes from the odd extension and the steady-state starts instead of the
 // signal, and the error this makes is not noise: it follows the signal's curvature at the end,
 // the same in every repetition of a run (what a model row must not carry). outside_share in
-// (0, 0.5); InputError otherwise. For the 5th-order low-pass at 0.05 of the sample rate and
+// (0, 0.5), and a response that has not decayed within 2^20 samples (a cut-off under about 2e-5
+// of the sample rate): InputError. For the 5th-order low-pass at 0.05 of the sample rate and
 // outside_share 0.01: 35 samples (1.75 / cut-off).
 Eigen::Index zero_phase_edge_reach(const Sos& sos, double outside_share);
 
