@@ -273,9 +273,12 @@ ready /tmp/chassis.err
 ready /tmp/car.err
 vm_log_tool aux-writer /tmp/imu.pipe /tmp/imu.csv $AUX_SECONDS 2>/tmp/aux.err &
 cangen vcan1 -I 0B0 -L 8 -g 10 -n $CHASSIS_FRAMES || vmfail "cangen vcan1" &
-canplayer -I /test/input.log vcan0=$PLAYED_IFACE || vmfail "canplayer"
-cansend vcan0 $ERROR_SEND || vmfail "cansend $ERROR_SEND"
-for f in $EXTRA_SEND; do cansend vcan0 "$f" || vmfail "cansend $f"; done
+# The senders on vcan0 run on one vCPU: vcan loops a frame back through the sending CPU's
+# backlog, so a sender that moves between the VM's two CPUs can have its frames delivered out of
+# order (seen once in CI under load: frames 36-44 arrived with timestamps going back).
+taskset -c 0 canplayer -I /test/input.log vcan0=$PLAYED_IFACE || vmfail "canplayer"
+taskset -c 0 cansend vcan0 $ERROR_SEND || vmfail "cansend $ERROR_SEND"
+for f in $EXTRA_SEND; do taskset -c 0 cansend vcan0 "$f" || vmfail "cansend $f"; done
 wait $dump
 echo "DYNID-DUMP-STATUS $?"
 cat /tmp/dump.err
@@ -294,7 +297,7 @@ dynid-socketcan-dump --frames 2 --seconds 20 --filter 1F334455 --filter 123:7FF 
   --output /tmp/filter.log vcan0 2>/tmp/filter.err &
 dump=$!
 ready /tmp/filter.err
-for f in 023#01 1F334456#02 00000123#03 1F334455#04 124#05 123#06; do cansend vcan0 $f; done
+for f in 023#01 1F334456#02 00000123#03 1F334455#04 124#05 123#06; do taskset -c 0 cansend vcan0 $f; done
 wait $dump
 echo "DYNID-FILTER-STATUS $?"
 
