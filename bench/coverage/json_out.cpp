@@ -29,6 +29,7 @@ nlohmann::json run_json(const SeedRun& r) {
   for (const ParameterSample& s : r.samples) samples.push_back(sample_json(s));
   return {{"manoeuvre", benchcar::manoeuvre_name(r.manoeuvre)},
           {"seed", r.seed},
+          {"mirrored", r.mirrored},
           {"seconds", r.seconds},
           {"error", r.error},
           {"parameters", samples}};

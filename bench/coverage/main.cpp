@@ -33,8 +33,8 @@ using namespace dynid;
 using namespace dynid::benchcoverage;
 
 void print_seed(const SeedRun& r) {
-  std::printf("%-12s seed %llu (%.1f s)", benchcar::manoeuvre_name(r.manoeuvre), static_cast<unsigned long long>(r.seed),
-              r.seconds);
+  std::printf("%-12s seed %llu%s (%.1f s)", benchcar::manoeuvre_name(r.manoeuvre), static_cast<unsigned long long>(r.seed),
+              r.mirrored ? " mirrored" : "", r.seconds);
   if (!r.error.empty()) std::printf(" ERROR: %s", r.error.c_str());
   const std::string* model = nullptr;  // named once before its parameters: two models share names
   for (const ParameterSample& s : r.samples) {
@@ -53,10 +53,13 @@ std::vector<SeedRun> measure_all(const Options& o, const car::VehicleProfile& pr
                                  const std::filesystem::path& work_dir) {
   std::vector<SeedRun> runs;
   for (benchcar::Manoeuvre m : o.manoeuvres)
-    for (int s = 1; s <= o.seeds; ++s) {
-      runs.push_back(measure_seed(profile, m, 1000 + static_cast<std::uint64_t>(s), o.noise_scale, work_dir, o.simex_draws));
-      print_seed(runs.back());
-    }
+    for (int s = 1; s <= o.seeds; ++s)
+      for (bool mirrored : {false, true}) {
+        if (mirrored && !o.antithetic) continue;
+        runs.push_back(measure_seed(profile, m, 1000 + static_cast<std::uint64_t>(s), o.noise_scale, work_dir,
+                                    o.simex_draws, mirrored));
+        print_seed(runs.back());
+      }
   return runs;
 }
 
@@ -79,8 +82,9 @@ int main(int argc, char** argv) {
     return failures == 0 ? 0 : 1;
   }
   const auto start = std::chrono::steady_clock::now();
-  std::printf("dynid-bench-coverage: %d clean runs per manoeuvre (seeds 1001-%d), the car's sensor noise x %g\n",
-              o.seeds, 1000 + o.seeds, o.noise_scale);
+  std::printf("dynid-bench-coverage: %d clean runs per manoeuvre (seeds 1001-%d%s), the car's sensor noise x %g\n",
+              o.antithetic ? 2 * o.seeds : o.seeds, 1000 + o.seeds,
+              o.antithetic ? ", each with its noise and the mirror of it" : "", o.noise_scale);
   const std::vector<SeedRun> runs = measure_all(o, profile, work_dir);
   std::filesystem::remove_all(work_dir);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

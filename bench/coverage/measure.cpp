@@ -100,14 +100,19 @@ const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre) {
 }
 
 SeedRun measure_seed(const car::VehicleProfile& profile, benchcar::Manoeuvre manoeuvre, std::uint64_t seed,
-                     double noise_scale, const std::filesystem::path& work_dir, int simex_draws) {
+                     double noise_scale, const std::filesystem::path& work_dir, int simex_draws, bool mirrored) {
   const auto t0 = std::chrono::steady_clock::now();
   SeedRun r;
   r.manoeuvre = manoeuvre;
   r.seed = seed;
+  r.mirrored = mirrored;
+  // The mirrored run's SIMEX draws are its own: the Monte Carlo error is not odd in the run's
+  // noise, so sharing the draws would not cancel it but make it common to the pair.
+  const std::uint64_t simex_seed = mirrored ? ~seed : seed;
   try {
-    const benchcar::CleanRun run = benchcar::clean_run(profile, manoeuvre, seed, noise_scale, work_dir);
-    for (const std::string& model : models_of(manoeuvre)) add_model(profile, model, run, seed, simex_draws, r.samples);
+    const benchcar::CleanRun run = benchcar::clean_run(profile, manoeuvre, seed, noise_scale, work_dir, mirrored);
+    for (const std::string& model : models_of(manoeuvre))
+      add_model(profile, model, run, simex_seed, simex_draws, r.samples);
   } catch (const std::exception& e) {
     r.error = e.what();
   }

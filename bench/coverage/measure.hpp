@@ -56,6 +56,7 @@ struct ParameterSample {
 struct SeedRun {
   benchcar::Manoeuvre manoeuvre = benchcar::Manoeuvre::kLongitudinal;
   std::uint64_t seed = 0;
+  bool mirrored = false;  ///< the seed's noise with every draw's sign flipped (--antithetic)
   double seconds = 0.0;
   std::string error;  ///< non-empty: the run or a fit failed (InputError text)
   std::vector<ParameterSample> samples;
@@ -64,9 +65,11 @@ struct SeedRun {
 /// The models identified on a manoeuvre (docs/RESIDUAL.md "Benchmark on a second car").
 const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre);
 
-/// One clean run at `seed` (sensor noise times noise_scale) and its fits, SIMEX with
-/// `simex_draws` draws per lambda. Never throws: a failure is SeedRun::error.
+/// One clean run at `seed` (sensor noise times noise_scale, its draws' signs flipped when
+/// `mirrored`) and its fits, SIMEX with `simex_draws` draws per lambda. Never throws: a failure
+/// is SeedRun::error.
 SeedRun measure_seed(const car::VehicleProfile& profile, benchcar::Manoeuvre manoeuvre, std::uint64_t seed,
-                     double noise_scale, const std::filesystem::path& work_dir, int simex_draws = 8);
+                     double noise_scale, const std::filesystem::path& work_dir, int simex_draws = 8,
+                     bool mirrored = false);
 
 }  // namespace dynid::benchcoverage

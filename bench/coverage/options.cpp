@@ -11,8 +11,8 @@ namespace {
 
 [[noreturn]] void usage(const std::string& why) {
   std::fprintf(stderr,
-               "%s\nusage: dynid-bench-coverage [--seeds N] [--manoeuvres longitudinal,lateral,launch] [--json FILE]\n"
-               "                            [--noise SCALE] [--simex-draws B] [--profile TOML] [--smoke]\n",
+               "%s\nusage: dynid-bench-coverage [--seeds N] [--antithetic] [--manoeuvres longitudinal,lateral,launch]\n"
+               "                            [--json FILE] [--noise SCALE] [--simex-draws B] [--profile TOML] [--smoke]\n",
                why.c_str());
   std::exit(2);
 }
@@ -42,6 +42,7 @@ Options parse_options(int argc, char** argv) {
     else if (a == "--manoeuvres") o.manoeuvres = manoeuvres_of(args.value());
     else if (a == "--noise") o.noise_scale = args.number(0, 10);
     else if (a == "--simex-draws") o.simex_draws = static_cast<int>(args.number(2, 1000));
+    else if (a == "--antithetic") o.antithetic = true;
     else if (a == "--json") o.json = args.value();
     else if (a == "--profile") o.profile = args.value();
     else if (a == "--smoke") o.smoke = true;

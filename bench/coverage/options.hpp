@@ -13,7 +13,11 @@ struct Options {
                                                  benchcar::Manoeuvre::kLaunch};
   double noise_scale = 1.0;  ///< the car's sensor noise times this (0: noise-free, to tell noise from model error)
   int simex_draws = 8;  ///< SIMEX draws per lambda (residual::SimexOptions::draws)
-  std::string json;  ///< per-seed values, empty: none
+  /// Each seed run twice, with its sensor noise and with the mirror of it (benchcar::BusOptions::
+  /// mirrored): antithetic pairs, whose mean error holds the estimator's bias without the terms
+  /// odd in the noise that dominate a mean over independent seeds (docs/ACCURACY.md).
+  bool antithetic = false;
+  std::string json;  ///< per-run values, empty: none
   std::string profile = DYNID_BENCHCAR_PROFILE;
   bool smoke = false;
 };

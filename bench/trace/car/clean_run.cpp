@@ -12,13 +12,13 @@ std::uint64_t run_seed(const std::string& name, std::uint64_t seed) {
 }
 
 CleanRun clean_run(const car::VehicleProfile& profile, Manoeuvre manoeuvre, std::uint64_t seed, double noise_scale,
-                   const std::filesystem::path& work_dir) {
+                   const std::filesystem::path& work_dir, bool mirrored_noise) {
   const CarParameters car;
   const Perturbation none;
   CleanRun r;
   r.name = std::string("clean-") + manoeuvre_name(manoeuvre) + "-" + std::to_string(seed);
   r.truth = simulate(manoeuvre, car, none, seed);
-  r.product = through_product(profile, r.truth, none, {noise_scale, run_seed(r.name, seed)}, r.name, work_dir);
+  r.product = through_product(profile, r.truth, none, {noise_scale, run_seed(r.name, seed), mirrored_noise}, r.name, work_dir);
   r.segments = ingest::preprocess_offline(r.product.recorded);
   return r;
 }

@@ -27,8 +27,9 @@ struct CleanRun {
 };
 
 /// Simulates `manoeuvre` at `seed` with no effect and sends it through the product (can.log in
-/// `work_dir`, removed after). InputError as through_product.
+/// `work_dir`, removed after); `mirrored_noise`: the same run with every noise draw's sign
+/// flipped (BusOptions::mirrored). InputError as through_product.
 CleanRun clean_run(const car::VehicleProfile& profile, Manoeuvre manoeuvre, std::uint64_t seed, double noise_scale,
-                   const std::filesystem::path& work_dir);
+                   const std::filesystem::path& work_dir, bool mirrored_noise = false);
 
 }  // namespace dynid::benchcar

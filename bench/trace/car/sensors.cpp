@@ -98,7 +98,8 @@ std::size_t write_can_log(const std::filesystem::path& path, const can::Database
         const double per_signal = si / static_cast<double>(s->signals.size());
         const double sigma = options.noise_scale * s->noise / std::sqrt(static_cast<double>(s->signals.size()));
         for (const std::string& name : s->signals) {
-          double v = per_signal + (sigma > 0.0 ? sigma * normal(rng) : 0.0);
+          const double sign = options.mirrored ? -1.0 : 1.0;
+          double v = per_signal + (sigma > 0.0 ? sign * sigma * normal(rng) : 0.0);
           // Toothed-wheel speed sensors read a standing shaft as exactly 0, without noise, and
           // never a negative speed (a slow shaft's noise would otherwise leave the DBC's range).
           if (s->channel == "engine_speed" || s->channel == "gearbox_input_speed")

@@ -30,6 +30,9 @@ const std::vector<SensorSpec>& sensor_set();
 struct BusOptions {
   double noise_scale = 1.0;  ///< 0: a noise-free run (quantization and float rounding only)
   std::uint64_t seed = 1;
+  /// Every noise draw of `seed` with its sign flipped: the second run of an antithetic pair
+  /// (bench/coverage --antithetic), whose error's odd terms in the noise cancel the first's.
+  bool mirrored = false;
 };
 
 /// Writes the run's CAN log (candump -l format, interface "can1") to `path`. Returns the
