@@ -7,9 +7,11 @@
 // weighted LS) and the HAC std of `dynid consistency`; and the same for the instrumental-variable
 // estimate (residual::iv_fit, issue 16 item 2) with how often its Durbin-Wu-Hausman test calls LS
 // biased at 1 %; and the SIMEX correction of LS for the measured channel noise (residual::simex_fit)
-// with what a table would publish with it. Prints one line per seed, the markdown
+// with what a table would publish with it. `--antithetic` runs every seed twice, with its noise
+// and with the mirror of it, so that the mean error carries the bias without the terms odd in the
+// noise (docs/ACCURACY.md "What 20 seeds can resolve"). Prints one line per run, the markdown
 // tables, a verdict per parameter against issue 16's goals and the run time; --json writes every
-// seed. Measurement only: no estimator is tuned here. `--smoke` is the ctest check of the harness.
+// run. Measurement only: no estimator is tuned here. `--smoke` is the ctest check of the harness.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
