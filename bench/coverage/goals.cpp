@@ -23,7 +23,7 @@ std::string accuracy_verdict(const std::string& parameter, double mean_error_pct
   int within = 0;
   for (double e : errors_pct) within += std::abs(e) <= goal ? 1 : 0;
   char b[200];
-  std::snprintf(b, sizeof b, "accuracy goal %.1f %%: mean error %+.2f %% %s, %d of %zu seeds within", goal,
+  std::snprintf(b, sizeof b, "accuracy goal %.1f %%: mean error %+.2f %% %s, %d of %zu runs within", goal,
                 mean_error_pct, std::abs(mean_error_pct) <= goal ? "within" : "OUTSIDE", within, errors_pct.size());
   return b;
 }
@@ -52,7 +52,7 @@ std::string iv_verdicts(const std::vector<ParameterCoverage>& rows) {
   std::string out;
   for (const ParameterCoverage& r : rows) {
     char b[120];
-    std::snprintf(b, sizeof b, "; %d seeds refused; DWH rejects at 1 %% in %.0f %%", r.iv.refused,
+    std::snprintf(b, sizeof b, "; %d runs refused; DWH rejects at 1 %% in %.0f %%", r.iv.refused,
                   100.0 * r.iv.dwh_rejections);
     out += "- " + r.model + " " + r.parameter + " by IV: " + std_verdict("IV", r.iv.textbook) + "; " +
            std_verdict("IV HAC", r.iv.hac) + "; " + accuracy_verdict(r.parameter, r.iv.mean_error_pct, r.iv.errors_pct) +
@@ -77,7 +77,7 @@ std::string without_simex_verdicts(const std::vector<ParameterCoverage>& rows) {
   for (const ParameterCoverage& r : rows) {
     const PublishedCoverage& p = r.without_simex;
     out += estimate_line(r, "without SIMEX (" + std::to_string(p.by_iv) + " of " + std::to_string(p.seeds) +
-                                " seeds by IV, the others least squares)",
+                                " runs by IV, the others least squares)",
                          "that table's", p.std, p.mean_error_pct, p.errors_pct);
   }
   return out;
@@ -87,7 +87,7 @@ std::string simex_verdicts(const std::vector<ParameterCoverage>& rows) {
   std::string out;
   for (const ParameterCoverage& r : rows) {
     const SimexCoverage& s = r.simex;
-    out += estimate_line(r, "by SIMEX (" + std::to_string(s.corrected) + " of " + std::to_string(s.seeds) + " seeds corrected)",
+    out += estimate_line(r, "by SIMEX (" + std::to_string(s.corrected) + " of " + std::to_string(s.seeds) + " runs corrected)",
                          "SIMEX", s.std, s.mean_error_pct, s.errors_pct);
   }
   return out;
@@ -98,7 +98,7 @@ std::string published_verdicts(const std::vector<ParameterCoverage>& rows) {
   for (const ParameterCoverage& r : rows) {
     const PublishedCoverage& p = r.published;
     out += estimate_line(r, "as published (" + std::to_string(p.by_iv) + " by IV, " + std::to_string(p.by_simex) +
-                                " by SIMEX of " + std::to_string(p.seeds) + " seeds)",
+                                " by SIMEX of " + std::to_string(p.seeds) + " runs)",
                          "published", p.std, p.mean_error_pct, p.errors_pct);
   }
   return out;

@@ -177,7 +177,7 @@ std::vector<ParameterCoverage> summarize(const std::vector<SeedRun>& runs) {
 }
 
 std::string markdown_table(const std::vector<ParameterCoverage>& rows) {
-  return table("| model | parameter | truth | seeds | mean error | scatter | table std | within 2 table std | mean error / "
+  return table("| model | parameter | truth | runs | mean error | scatter | table std | within 2 table std | mean error / "
                "table std | HAC std | within 2 HAC std | mean error / HAC std |",
                rows, [](const ParameterCoverage& r) {
                  return start(r, "%.6g | %d | %+.3g %% | %.3g %% |", r.truth, r.seeds, r.mean_error_pct, r.scatter_pct) +
@@ -186,7 +186,7 @@ std::string markdown_table(const std::vector<ParameterCoverage>& rows) {
 }
 
 std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows) {
-  return table("| model | parameter | LS mean error | IV seeds | IV mean error | IV scatter | IV std | within 2 IV std | "
+  return table("| model | parameter | LS mean error | IV runs | IV mean error | IV scatter | IV std | within 2 IV std | "
                "mean error / IV std | IV HAC std | within 2 IV HAC std | mean error / IV HAC std | DWH rejects at 1 % |",
                rows, [](const ParameterCoverage& r) {
                  return start(r, "%+.3g %% | %d | %+.3g %% | %.3g %% |", r.mean_error_pct, r.iv.seeds,
@@ -200,7 +200,7 @@ std::string iv_markdown_table(const std::vector<ParameterCoverage>& rows) {
 namespace dynid::benchcoverage {
 
 std::string without_simex_markdown_table(const std::vector<ParameterCoverage>& rows) {
-  return table("| model | parameter | seeds | by IV | mean error | scatter | std | within 2 std | mean error / std |", rows,
+  return table("| model | parameter | runs | by IV | mean error | scatter | std | within 2 std | mean error / std |", rows,
                [](const ParameterCoverage& r) {
                  return start(r, "%d | %d | %+.3g %% | %.3g %% |", r.without_simex.seeds, r.without_simex.by_iv,
                               r.without_simex.mean_error_pct, r.without_simex.scatter_pct) +
@@ -209,7 +209,7 @@ std::string without_simex_markdown_table(const std::vector<ParameterCoverage>& r
 }
 
 std::string simex_markdown_table(const std::vector<ParameterCoverage>& rows) {
-  return table("| model | parameter | LS mean error | IV mean error | SIMEX seeds | corrected | SIMEX mean error | SIMEX "
+  return table("| model | parameter | LS mean error | IV mean error | SIMEX runs | corrected | SIMEX mean error | SIMEX "
                "scatter | SIMEX std | within 2 SIMEX std | mean error / SIMEX std | of it Monte Carlo |",
                rows, [](const ParameterCoverage& r) {
                  return start(r, "%+.3g %% | %+.3g %% | %d | %d | %+.3g %% | %.3g %% |", r.mean_error_pct,
@@ -220,7 +220,7 @@ std::string simex_markdown_table(const std::vector<ParameterCoverage>& rows) {
 }
 
 std::string published_markdown_table(const std::vector<ParameterCoverage>& rows) {
-  return table("| model | parameter | seeds | by IV | by SIMEX | mean error | scatter | std | within 2 std | mean error / "
+  return table("| model | parameter | runs | by IV | by SIMEX | mean error | scatter | std | within 2 std | mean error / "
                "std |",
                rows, [](const ParameterCoverage& r) {
                  return start(r, "%d | %d | %d | %+.3g %% | %.3g %% |", r.published.seeds, r.published.by_iv,
