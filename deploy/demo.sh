@@ -37,7 +37,7 @@ run_id="$scenario-$(date -u +%Y%m%dT%H%M%SZ)"
 if [ "${DEMO_SKIP_SETUP:-0}" != 1 ]; then
   BUILD_DIR=$build bash deploy/setup.sh
 fi
-sim=$build/tests/sim/dynid-sim
+sim=$build/tools/sim/dynid-sim
 server=$build/server/dynid-server
 car=$build/client/car/dynid-car
 cli=$build/client/cli/dynid

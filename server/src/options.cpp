@@ -13,7 +13,7 @@
 #include "dynid/dds/participant.hpp"
 #include "dynid/error.hpp"
 #include "dynid/input/ids.hpp"
-#include "dynid/input/option_checks.hpp"
+#include "dynid/options/option_checks.hpp"
 #include "dynid/store/location.hpp"
 
 namespace dynid::server {

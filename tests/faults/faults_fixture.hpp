@@ -1,6 +1,6 @@
 #pragma once
 // Shared by the fault-injection tests (label faults): dynid-server, dynid-car and dynid as
-// processes on the client tests' loopback configuration (tests/client/client_fixture.hpp: the
+// processes on the client tests' loopback configuration (tests/car/client_fixture.hpp: the
 // discovery tag of this test process, Child, simulated runs, the chunks the car cuts), the
 // server's store read read-only after the fact, final estimates compared with those of an
 // uninterrupted run, and a small real filesystem that can be filled up.

@@ -1,6 +1,6 @@
 #pragma once
 // The benchmark's second car (bench/trace, issue 15): a 1850 kg rear-driven SUV, written
-// independently of the reference simulator (tests/sim), with its own geometry, tyres, drag,
+// independently of the reference simulator (tools/sim), with its own geometry, tyres, drag,
 // driveline and clutch. These are the truths the benchmark compares the product's estimates
 // with; bench/trace/benchcar.toml holds the constants an engineer would know (geometry, the
 // weighed mass, radii), not the identified ones.

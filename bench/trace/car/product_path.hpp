@@ -2,7 +2,7 @@
 // The product's data path for the second car, as dynid-car runs it: the simulated can.log
 // replayed through dynid_car_core (CandumpSource -> CarPipeline with bench/trace/benchcar.toml:
 // DBC decoding, unit conversion, resampling onto the grid, chunks), the chunks assembled into
-// the run the server stores (ingest::assemble_run). Nothing of tests/sim is used.
+// the run the server stores (ingest::assemble_run). Nothing of tools/sim is used.
 #include <filesystem>
 #include <string>
 

@@ -44,7 +44,7 @@
 
 #include <dynid/dds/participant.hpp>
 #include <dynid/error.hpp>
-#include <dynid/input/option_checks.hpp>
+#include <dynid/options/option_checks.hpp>
 
 #include "dynid/car/auxiliary.hpp"
 #include "dynid/car/live_merge.hpp"

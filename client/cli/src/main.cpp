@@ -19,7 +19,7 @@
 #include <sstream>
 #include <unistd.h>
 
-#include <dynid/input/option_checks.hpp>
+#include <dynid/options/option_checks.hpp>
 
 #include "dynid/cli/request_client.hpp"
 #include "dynid/cli/shard_replies.hpp"

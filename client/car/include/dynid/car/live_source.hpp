@@ -1,7 +1,7 @@
 #pragma once
 // LiveSource: an auxiliary source read while the run is live, beside the bus (live_merge.hpp
 // merges it): a CSV file or named pipe a logger writes (auxiliary_follower.hpp), or a second CAN
-// interface with its own DBC (can_interface_follower.hpp, client/socketcan).
+// interface with its own DBC (can_interface_follower.hpp, client/car/src/socketcan).
 //
 // Contract:
 // - poll() never blocks: it returns the rows that arrived since the last call, sorted by time,

@@ -21,7 +21,7 @@ double correction_z(const residual::SimexFit& f, Eigen::Index j) {
 }
 
 // Where the bias test keeps least squares: SIMEX wherever it corrected and estimates the parameter
-// (server/estimate_tables.hpp apply_simex; the server also requires the row identified).
+// (residual/publication.hpp; the rule also requires the row identified).
 bool simex_published(const residual::SimexFit& f, Eigen::Index j) { return f.corrected() && std::isfinite(f.value(j)); }
 
 const char* published(const residual::SimexFit& f, Eigen::Index j) {

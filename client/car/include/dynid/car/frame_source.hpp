@@ -1,7 +1,7 @@
 #pragma once
 // FrameSource: where the car-side pipeline gets its CAN frames. The replay reader (a candump log,
-// candump_source.hpp) and the live SocketCAN reader (client/socketcan/) both implement it, so the
-// mapping, resampling, chunking and spool code never knows which one feeds it.
+// candump_source.hpp) and the live SocketCAN reader (client/car/src/socketcan/) both implement it,
+// so the mapping, resampling, chunking and spool code never knows which one feeds it.
 //
 // Contract:
 // - next() fills `frame` and returns Frame, or returns End once the source is exhausted (a log at

@@ -77,7 +77,7 @@ struct RunSources {
 };
 
 /// Opens a CAN source live on an interface (given as its --source NAME=INTERFACE); dynid-car
-/// gives one (client/socketcan, can_interface_follower.hpp).
+/// gives one (client/car/src/socketcan, can_interface_follower.hpp).
 using LiveCanOpener =
     std::function<std::unique_ptr<LiveSource>(const AuxiliarySourceSpec&, const std::string& interface, double offset)>;
 

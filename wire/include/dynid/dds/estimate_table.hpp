@@ -73,9 +73,9 @@ struct EstimateTable {
   std::string residual_statement = {};
   std::uint64_t residual_through = 0;
   /// Whose values the rows are (kLeastSquares, kInstrumentalVariables or kSimex:
-  /// server/estimate_tables.hpp apply_iv, apply_simex) and the bias test's one line (residual/iv_fit.hpp IvFit::statement(); "" when not
-  /// computed: the live judgement off, a pool, too few rows), `bias_through` the last chunk the
-  /// test includes.
+  /// residual/publication.hpp) and the bias test's one line (residual/iv_fit.hpp
+  /// IvFit::statement(); "" when not computed: the live judgement off, a pool, too few rows),
+  /// `bias_through` the last chunk the test includes.
   std::string estimator = kLeastSquares;
   std::string bias_test = {};
   std::uint64_t bias_through = 0;

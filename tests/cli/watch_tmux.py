@@ -25,7 +25,7 @@ import tempfile
 import time
 
 build, source = sys.argv[1:3]
-sim_bin = os.path.join(build, "tests", "sim", "dynid-sim")
+sim_bin = os.path.join(build, "tools", "sim", "dynid-sim")
 server_bin = os.path.join(build, "server", "dynid-server")
 car_bin = os.path.join(build, "client", "car", "dynid-car")
 cli_bin = os.path.join(build, "client", "cli", "dynid")

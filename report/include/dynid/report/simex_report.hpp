@@ -3,7 +3,7 @@
 // (`dynid simex`): per parameter the least-squares value and its HAC std, the value corrected
 // for the measured sensor noise with its std and that std's parts (Monte Carlo, the noise
 // levels' own uncertainty), the correction in stds, and which of the two the server publishes
-// where the bias test does not send the model to IV (server/estimate_tables.hpp apply_simex).
+// where the bias test does not send the model to IV (residual/publication.hpp).
 // Text and JSON.
 #include <string>
 
