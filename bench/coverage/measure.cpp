@@ -41,6 +41,10 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
   const residual::IvFit iv = benchcar::declared_iv(profile, model, run.product.recorded, run.segments);
   const residual::SimexFit simex = declared_simex(profile, model, run, seed, simex_draws);
   const bool simex_over_iv = residual::compare_simex_with_iv(iv, simex).simex_stands;
+  const residual::Publication published =
+      residual::publish(fit.parameters, fit.estimate, fit.column_norms, &iv, &simex);
+  const residual::Publication without_simex =
+      residual::publish(fit.parameters, fit.estimate, fit.column_norms, &iv, nullptr);
   for (std::size_t i = 0; i < fit.parameters.size(); ++i) {
     const std::string& name = fit.parameters[i].name;
     const auto truth = run.truth.parameters.find(name);
@@ -70,6 +74,16 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
       s.simex_corrected = simex.corrected();
     }
     s.simex_over_iv = simex_over_iv;
+    if (k < published.value.size()) {
+      s.published_value = published.value(k);
+      s.published_std = published.std(k);
+      s.published_by =
+          published.replaced[i] ? published.estimator : residual::PublishedEstimator::kLeastSquares;
+      s.without_simex_value = without_simex.value(k);
+      s.without_simex_std = without_simex.std(k);
+      s.without_simex_by = without_simex.replaced[i] ? without_simex.estimator
+                                                     : residual::PublishedEstimator::kLeastSquares;
+    }
     s.dwh_rejects = iv.dwh.rejects;
     s.iv_instrument_f = iv.instrument_f;
     s.iv_refused = iv.reason;

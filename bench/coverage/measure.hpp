@@ -15,6 +15,8 @@
 
 #include <dynid/car/vehicle_profile.hpp>
 
+#include "dynid/residual/publication.hpp"
+
 #include "car/manoeuvres.hpp"
 
 namespace dynid::benchcoverage {
@@ -46,6 +48,14 @@ struct ParameterSample {
   /// Hausman's comparison lets SIMEX stand in for IV (residual::compare_simex_with_iv, the model's
   /// fits as a whole): published in IV's place where DWH rejects least squares.
   bool simex_over_iv = false;
+  /// What the product publishes (residual::publish, the server's rule) with both fits, and with
+  /// the IV fit alone (the rule before SIMEX): value, std and the estimator that gave them.
+  double published_value = kNaN;
+  double published_std = kNaN;
+  residual::PublishedEstimator published_by = residual::PublishedEstimator::kLeastSquares;
+  double without_simex_value = kNaN;
+  double without_simex_std = kNaN;
+  residual::PublishedEstimator without_simex_by = residual::PublishedEstimator::kLeastSquares;
   /// (value - truth) / |truth|: relative, so that a negative truth (the clutch's viscous slope)
   /// keeps the error's sign.
   double relative_error() const;

@@ -76,22 +76,18 @@ SimexCoverage simex_of(const std::vector<const ParameterSample*>& samples) {
   return c;
 }
 
-// with_simex false: IV where DWH rejects least squares, else least squares; true: the server's
-// rule (server/estimate_tables.hpp apply_iv, apply_simex): SIMEX in place of IV where Hausman's
-// comparison lets it stand, and in place of least squares wherever it corrected the rows.
+// What the product publishes (residual::publish, the server's own rule; ParameterSample's
+// published_*), with SIMEX or, with_simex false, with the IV fit alone.
 PublishedCoverage published_of(const std::vector<const ParameterSample*>& samples, bool with_simex) {
   PublishedCoverage c;
   std::vector<double> stds;
   for (const ParameterSample* s : samples) {
-    const bool iv_estimated = s->dwh_rejects && std::isfinite(s->iv_value) && std::isfinite(s->iv_hac_std);
-    const bool simex = with_simex && (iv_estimated ? s->simex_over_iv : s->simex_corrected) &&
-                       std::isfinite(s->simex_value) && std::isfinite(s->simex_std);
-    const bool iv = iv_estimated && !simex;
-    const double value = iv ? s->iv_value : simex ? s->simex_value : s->value;
-    const double std = iv ? s->iv_hac_std : simex ? s->simex_std : s->std;
+    const double value = with_simex ? s->published_value : s->without_simex_value;
+    const double std = with_simex ? s->published_std : s->without_simex_std;
+    const residual::PublishedEstimator by = with_simex ? s->published_by : s->without_simex_by;
     if (!std::isfinite(value) || !std::isfinite(std)) continue;
-    c.by_iv += iv ? 1 : 0;
-    c.by_simex += simex ? 1 : 0;
+    c.by_iv += by == residual::PublishedEstimator::kInstrumentalVariables ? 1 : 0;
+    c.by_simex += by == residual::PublishedEstimator::kSimex ? 1 : 0;
     c.errors_pct.push_back(100.0 * (value - s->truth) / std::abs(s->truth));
     stds.push_back(100.0 * std / std::abs(s->truth));
   }

@@ -40,12 +40,11 @@ struct SimexCoverage {
   StdCoverage std;    ///< sqrt(LS HAC^2 + Monte Carlo^2 + noise level^2)
 };
 
-/// What a table publishes. `without_simex`: IV's value and HAC std where the model's
-/// Durbin-Wu-Hausman test rejects least squares at 1 %, else least squares' (what the server
-/// published before SIMEX). `published`: what the server publishes (server/estimate_tables.hpp,
-/// apply_iv then apply_simex): SIMEX's value and std in place of least squares' wherever SIMEX
-/// corrected the rows, and in place of IV where Hausman's comparison lets it stand
-/// (residual/simex_against_iv.hpp; docs/ACCURACY.md says why).
+/// What a table publishes, by the server's own rule (residual/publication.hpp, residual::publish).
+/// `without_simex`: the rule given the IV fit alone (IV's value and HAC std where the model's
+/// Durbin-Wu-Hausman test rejects least squares, else least squares'). `published`: the rule given
+/// both fits: SIMEX in place of least squares on the identified rows wherever it corrected them,
+/// and in place of IV where Hausman's comparison lets it stand (docs/ACCURACY.md says why).
 struct PublishedCoverage {
   int seeds = 0;     ///< seeds with a finite published value and std
   int by_iv = 0;     ///< of which by IV

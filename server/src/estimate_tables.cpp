@@ -5,7 +5,7 @@
 
 #include "dynid/report/estimate_report.hpp"
 #include "dynid/report/json.hpp"
-#include "dynid/residual/simex_against_iv.hpp"
+#include "dynid/residual/publication.hpp"
 
 namespace dynid::server {
 
@@ -27,15 +27,6 @@ dds::EstimateTable table_of(const std::string& vehicle, const std::string& sourc
 }
 
 namespace {
-
-bool same_columns(const std::vector<model::ParameterInfo>& parameters,
-                  const std::vector<model::ParameterInfo>& fitted, const Eigen::VectorXd& value) {
-  if (fitted.size() != parameters.size() || value.size() != static_cast<Eigen::Index>(parameters.size()))
-    return false;
-  for (std::size_t k = 0; k < parameters.size(); ++k)
-    if (fitted[k].name != parameters[k].name) return false;
-  return true;
-}
 
 // The rows `replace` marks get `value` and `std` in place of least squares', which is kept beside
 // them; the statuses are classified again on the new values; the table names `estimator`.
@@ -64,56 +55,33 @@ void replace_rows(dds::EstimateTable& table, const std::vector<model::ParameterI
   table.estimator = estimator;
 }
 
-// Where IV replaced least squares: SIMEX takes every row IV took when Hausman's comparison says
-// its noise model holds (residual/simex_against_iv.hpp); the bias test's line says which way.
-void simex_in_place_of_iv(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
-                          const ls::WeightedEstimate& estimate, const residual::SimexFit& simex,
-                          const residual::IvFit& iv) {
-  const residual::SimexAgainstIv comparison = residual::compare_simex_with_iv(iv, simex);
-  if (!comparison.compared) return;
-  table.bias_test += "; " + comparison.statement();
-  if (!comparison.simex_stands) return;
-  std::vector<bool> replace(parameters.size());
-  for (std::size_t k = 0; k < replace.size(); ++k) {
-    const auto j = static_cast<Eigen::Index>(k);
-    replace[k] = std::isfinite(iv.value(j)) && std::isfinite(simex.value(j)) && std::isfinite(estimate.estimate.value(j));
+const char* name_of(residual::PublishedEstimator estimator) {
+  switch (estimator) {
+    case residual::PublishedEstimator::kLeastSquares:
+      return dds::kLeastSquares;
+    case residual::PublishedEstimator::kInstrumentalVariables:
+      return dds::kInstrumentalVariables;
+    case residual::PublishedEstimator::kSimex:
+      return dds::kSimex;
   }
-  replace_rows(table, parameters, estimate, simex.value, simex.std, replace, dds::kSimex);
+  return dds::kLeastSquares;
 }
 
 }  // namespace
 
-void apply_iv(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
-              const ls::WeightedEstimate& estimate, const residual::IvFit& iv, std::uint64_t through) {
-  if (!same_columns(parameters, iv.parameters, iv.value)) return;
-  table.bias_test = iv.statement();
-  table.bias_through = through;
-  if (!iv.replaces_least_squares()) return;
-  std::vector<bool> replace(parameters.size());
-  for (std::size_t k = 0; k < replace.size(); ++k) {
-    const auto j = static_cast<Eigen::Index>(k);
-    replace[k] = std::isfinite(iv.value(j)) && std::isfinite(estimate.estimate.value(j));
+void apply_publication(dds::EstimateTable& table,
+                       const std::vector<model::ParameterInfo>& parameters,
+                       const ls::WeightedEstimate& estimate, const residual::IvFit* iv,
+                       const residual::SimexFit* simex, std::uint64_t through) {
+  const residual::Publication published = residual::publish(
+      parameters, estimate.estimate, model::column_norms(estimate.weighted), iv, simex);
+  if (published.bias_tested) {
+    table.bias_test = published.bias_test;
+    table.bias_through = through;
   }
-  replace_rows(table, parameters, estimate, iv.value, iv.hac_std, replace, dds::kInstrumentalVariables);
-}
-
-void apply_simex(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
-                 const ls::WeightedEstimate& estimate, const residual::SimexFit& simex, const residual::IvFit* iv) {
-  if (!same_columns(parameters, simex.parameters, simex.value)) return;
-  if (table.estimator == dds::kInstrumentalVariables) {
-    if (iv != nullptr) simex_in_place_of_iv(table, parameters, estimate, simex, *iv);
-    return;
-  }
-  if (table.estimator != dds::kLeastSquares) return;
-  std::vector<bool> replace(parameters.size());
-  bool any = false;
-  for (std::size_t k = 0; k < replace.size(); ++k) {
-    const auto j = static_cast<Eigen::Index>(k);
-    replace[k] = simex.corrected() && std::isfinite(simex.value(j)) && std::isfinite(estimate.estimate.value(j)) &&
-                 table.parameters[k].status == ls::ParameterStatus::kIdentified;
-    any = any || replace[k];
-  }
-  if (any) replace_rows(table, parameters, estimate, simex.value, simex.std, replace, dds::kSimex);
+  if (published.estimator == residual::PublishedEstimator::kLeastSquares) return;
+  replace_rows(table, parameters, estimate, published.value, published.std, published.replaced,
+               name_of(published.estimator));
 }
 
 EstimateTables tables_of(const std::string& vehicle, const std::string& source,

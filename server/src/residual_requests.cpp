@@ -181,7 +181,7 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
       // No row yet: no IV estimate (a refusal for weak instruments is a result, not this).
     }
     // SIMEX beside IV too: where IV replaces least squares, SIMEX stands in for it when Hausman's
-    // comparison of the two says its noise model holds (server/estimate_tables.hpp apply_simex).
+    // comparison of the two says its noise model holds (residual/publication.hpp).
     try {
       if (!noise) noise = run_noise(run, segments);
       verdict.simex = simex_of(*model, spec.effects, run, segments, *noise);

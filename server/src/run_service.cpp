@@ -8,13 +8,14 @@
 #include <dynid/input/ids.hpp>
 
 #include "dynid/dds/conversions.hpp"
+#include "dynid/dds/protocol.hpp"
 #include "dynid/report/estimate_report.hpp"
 
 namespace dynid::server {
 
 namespace {
 
-constexpr std::size_t kMaxRejectionsKept = 64;  // = dynid_wire_kMaxRejections
+using dds::protocol::kAnnouncementSequence;
 constexpr std::uint64_t kReplayBatch = 16;      // chunks read from the store per lock
 constexpr std::size_t kMaxBatch = 256;          // chunks stored per transaction at most
 constexpr std::size_t kMaxInFlight = 2;         // batches a worker has at the committer at most
@@ -139,7 +140,7 @@ void RunService::reject(const store::RunKey& key, RunState* run, std::uint64_t s
     return;
   }
   run->rejections.push_back({sequence, reason});
-  if (run->rejections.size() > kMaxRejectionsKept) run->rejections.pop_front();
+  if (run->rejections.size() > dds::protocol::kMaxRejections) run->rejections.pop_front();
   publish_ack(key, run);
 }
 
@@ -537,9 +538,8 @@ void RunService::attach_live(const RunState& run, const std::vector<ingest::Mode
     const auto estimate = std::find_if(estimates.begin(), estimates.end(),
                                        [&](const ingest::ModelEstimate& e) { return e.model == table.model; });
     if (estimate == estimates.end() || !estimate->estimate) continue;
-    if (live.iv) apply_iv(table, estimate->parameters, *estimate->estimate, *live.iv, through);
-    if (live.simex)
-      apply_simex(table, estimate->parameters, *estimate->estimate, *live.simex, live.iv ? &*live.iv : nullptr);
+    apply_publication(table, estimate->parameters, *estimate->estimate,
+                      live.iv ? &*live.iv : nullptr, live.simex ? &*live.simex : nullptr, through);
   }
 }
 

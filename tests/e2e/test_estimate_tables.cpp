@@ -1,5 +1,5 @@
-// The publication rule on the server's tables (server/estimate_tables.hpp): apply_iv, then
-// apply_simex with the IV fit, on a least-squares table of two parameters and fits built by hand.
+// The publication rule on the server's tables (server/estimate_tables.hpp: apply_publication,
+// residual/publication.hpp), on a least-squares table of two parameters and fits built by hand.
 // Where IV replaced least squares, SIMEX takes its rows only when Hausman's comparison lets it
 // stand; the bias test's line says which way; least squares stays beside either.
 #include <gtest/gtest.h>
@@ -65,8 +65,7 @@ residual::SimexFit simex_at(const Eigen::Vector2d& value) {
 dds::EstimateTable published(const residual::SimexFit& simex, const residual::IvFit* iv) {
   const ls::WeightedEstimate estimate = least_squares();
   dds::EstimateTable table = table_of("car", "run", "m", parameters(), estimate);
-  if (iv != nullptr) apply_iv(table, parameters(), estimate, *iv, 7);
-  apply_simex(table, parameters(), estimate, simex, iv);
+  apply_publication(table, parameters(), estimate, iv, &simex, 7);
   return table;
 }
 
@@ -96,14 +95,15 @@ TEST(EstimateTables, SimexDisagreeingWithIvLeavesIvsRowsAndSaysWhy) {
   EXPECT_EQ(table.parameters[1].standard_deviation, iv.hac_std(1));
 }
 
-TEST(EstimateTables, WithoutTheIvFitAnIvTableIsLeftAsItIs) {
-  const residual::IvFit iv = iv_rejecting_least_squares();
+TEST(EstimateTables, AnIvFitOfOtherColumnsIsIgnored) {
+  residual::IvFit iv = iv_rejecting_least_squares();
+  iv.parameters[1].name = "c";  // another effect set's columns
   const ls::WeightedEstimate estimate = least_squares();
   dds::EstimateTable table = table_of("car", "run", "m", parameters(), estimate);
-  apply_iv(table, parameters(), estimate, iv, 7);
-  apply_simex(table, parameters(), estimate, simex_at(Eigen::Vector2d(1.021, 2.03)), nullptr);
-  EXPECT_EQ(table.estimator, dds::kInstrumentalVariables);
-  EXPECT_EQ(table.bias_test, iv.statement());
+  apply_publication(table, parameters(), estimate, &iv, nullptr, 7);
+  EXPECT_EQ(table.estimator, dds::kLeastSquares);
+  EXPECT_EQ(table.bias_test, "");
+  EXPECT_EQ(table.parameters[1].value, estimate.estimate.value(1));
 }
 
 }  // namespace

@@ -2,12 +2,12 @@
 
 #include <algorithm>
 
+#include "dynid/dds/protocol.hpp"
+
 namespace dynid::car {
 namespace {
 
-// The sequence the server's receipt carries for a rejection of the announcement itself
-// (dynid-server, run_service.hpp: kAnnouncementSequence).
-constexpr std::uint64_t kAnnouncementSequence = ~std::uint64_t{0};
+using dds::protocol::kAnnouncementSequence;
 
 std::string name_of(const std::string& vehicle, const std::string& run, std::uint64_t sequence) {
   if (sequence == kAnnouncementSequence) return "the announcement of " + vehicle + "/" + run;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include "dynid/dds/protocol.hpp"
 #include "dynid/error.hpp"
 
 namespace dynid::cli {
@@ -88,30 +89,13 @@ std::string merged_status(const ShardReplies& replies) {
 
 namespace {
 
-// What each counter of the server's status counts (server/src/counters.cpp names them).
-constexpr std::pair<const char*, const char*> kCounterMeaning[] = {
-    {"announcements", "run announcements accepted"},
-    {"rejected_announcements", "run announcements rejected"},
-    {"chunks_stored", "chunks stored durably (acknowledged)"},
-    {"chunks_duplicate", "chunks received again (already stored)"},
-    {"chunks_rejected", "chunks rejected (bad, state unchanged)"},
-    {"chunks_folded", "chunks folded into estimates"},
-    {"chunks_replayed", "chunks replayed from the store"},
-    {"checkpoints", "accumulator checkpoints saved"},
-    {"estimates_published", "estimates published"},
-    {"requests", "engineer requests received"},
-    {"requests_rejected", "engineer requests refused"},
-    {"not_owned", "samples of vehicles served elsewhere"},
-    {"store_errors", "store errors"},
-};
-
 std::string counter_lines(const ordered_json& counters, const std::string& indent) {
   std::string out;
   for (const auto& [key, value] : counters.items()) {
     if (key == "server" || key == "servers") continue;  // server_lines()
     std::string label = key;
-    for (const auto& [name, meaning] : kCounterMeaning)
-      if (key == name) label = meaning;
+    for (const auto& counter : dds::protocol::kServerCounters)
+      if (key == counter.name) label = counter.meaning;
     out += indent + label + std::string(label.size() < 42 ? 42 - label.size() : 1, ' ') +
            (value.is_string() ? value.get<std::string>() : value.dump()) + "\n";
   }

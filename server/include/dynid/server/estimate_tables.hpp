@@ -26,30 +26,21 @@ dds::EstimateTable table_of(const std::string& vehicle, const std::string& sourc
                             const std::vector<model::ParameterInfo>& parameters,
                             const ls::WeightedEstimate& estimate);
 
-/// The instrumental-variable estimate on `table` (made by table_of from `parameters` and
-/// `estimate`): where iv.replaces_least_squares() (IV estimated, least squares rejected by the
-/// Durbin-Wu-Hausman test) the identified parameters get IV's values and HAC standard deviations,
-/// their statuses classified again on those, and the least-squares ones they replace; the test's
-/// one line (IvFit::statement()) either way, with `through`, the last chunk the IV fit includes.
-/// An IV fit of other columns (another effect set) is not applied: `table` is left as it is.
-void apply_iv(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
-              const ls::WeightedEstimate& estimate, const residual::IvFit& iv, std::uint64_t through);
-
-/// The SIMEX correction on `table` (made by table_of, apply_iv applied first with `iv`, null when
-/// there is no IV fit). Where the table is still least squares' and SIMEX corrected the rows (some
-/// channel's noise reaches them), every identified parameter gets SIMEX's value and std, with the
-/// least-squares ones it replaces beside it; statuses are classified again, and the estimator is
-/// kSimex when any row changed. Why every one, even where the correction is within its own
-/// uncertainty: the fold's table std counts every decimated row as independent, and SIMEX's std
-/// (least squares' HAC std and the correction's own uncertainty) is the one that covers the error
-/// (docs/ACCURACY.md). Where IV replaced least squares (the bias test has
-/// seen the bias in the data), SIMEX takes IV's rows only when Hausman's comparison of the two
-/// says its noise model holds (residual::compare_simex_with_iv), and the bias test's line gets
-/// that comparison's statement either way (docs/ACCURACY.md). A fit of other columns is not
-/// applied.
-void apply_simex(dds::EstimateTable& table, const std::vector<model::ParameterInfo>& parameters,
-                 const ls::WeightedEstimate& estimate, const residual::SimexFit& simex,
-                 const residual::IvFit* iv = nullptr);
+/// The publication rule (residual/publication.hpp: least squares, IV where the Durbin-Wu-Hausman
+/// test rejects it, SIMEX where it corrected the rows or where Hausman's comparison lets it stand
+/// in for IV) on `table`, made by table_of from `parameters` and `estimate`; `iv` and `simex` are
+/// the run's fits of the same configuration (null: not computed; a fit of other columns is
+/// ignored). The replaced rows get the chosen estimator's values and std with the least-squares
+/// ones beside them, and their statuses are classified again on those; the fit's figures stay
+/// least squares'. Where an IV fit was given, the bias test's line (and `through`, the last chunk
+/// the fits include) is set whichever estimator is published. Why SIMEX on every identified row,
+/// even where the correction is within its own uncertainty: the fold's table std counts every
+/// decimated row as independent, and SIMEX's std (least squares' HAC std and the correction's own
+/// uncertainty) is the one that covers the error (docs/ACCURACY.md).
+void apply_publication(dds::EstimateTable& table,
+                       const std::vector<model::ParameterInfo>& parameters,
+                       const ls::WeightedEstimate& estimate, const residual::IvFit* iv,
+                       const residual::SimexFit* simex, std::uint64_t through);
 
 EstimateTables tables_of(const std::string& vehicle, const std::string& source,
                          const std::vector<ingest::ModelEstimate>& estimates,

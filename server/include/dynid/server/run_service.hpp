@@ -97,9 +97,6 @@ struct FleetSource {
   std::vector<std::string> runs;
 };
 
-/// The sequence a rejection of the announcement itself carries in a ChunkAck.
-inline constexpr std::uint64_t kAnnouncementSequence = ~std::uint64_t{0};
-
 class RunService {
  public:
   explicit RunService(ServerContext& context) : context_(context) {}
@@ -257,10 +254,8 @@ class RunService {
   /// A finished diagnosis into its run, which is then published again.
   void collect_residual_job();
   /// The run's live judgement into its tables (nothing when off or not computed): the residual
-  /// verdict, and the bias test with IV's values where it rejects least squares (apply_iv),
-  /// SIMEX's in their place where Hausman's comparison lets it stand, and elsewhere SIMEX's where
-  /// the measured noise reaches the rows (apply_simex; `estimates`: those the tables were made
-  /// from).
+  /// verdict, and the values the publication rule chooses from the IV and SIMEX fits
+  /// (apply_publication, residual/publication.hpp; `estimates`: those the tables were made from).
   static void attach_live(const RunState& run, const std::vector<ingest::ModelEstimate>& estimates,
                           EstimateTables& tables);
   /// Writes `tables` to the Estimate topic, each with the next revision (set in `tables`).
