@@ -15,6 +15,7 @@
 #include <dynid/error.hpp>
 
 #include "can_test_support.hpp"
+#include "temp_dir.hpp"
 
 namespace dynid::can {
 namespace {
@@ -32,18 +33,7 @@ std::vector<std::string> described(const LogReader& r) {
   return out;
 }
 
-class TempDir {
- public:
-  TempDir() {
-    char name[] = "/tmp/dynid-vector-XXXXXX";
-    path_ = mkdtemp(name);
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+using ::dynid::test::TempDir;
 
 TEST(AscReader, ReadsClassicExtendedRemoteAndFdFramesWithTheMeasurementStart) {
   std::istringstream in(

@@ -41,17 +41,6 @@ bool rows_match(const std::vector<Reference>& expected,
 
 }  // namespace
 
-TempDir::TempDir() {
-  std::string pattern = (std::filesystem::temp_directory_path() / "dynid-e2e-XXXXXX").string();
-  if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-  path_ = pattern;
-}
-
-TempDir::~TempDir() {
-  std::error_code ignored;
-  std::filesystem::remove_all(path_, ignored);
-}
-
 namespace {
 // Set once by use_open_network(), before the first participant.
 std::optional<dds_domainid_t> open_domain;

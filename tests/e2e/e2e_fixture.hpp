@@ -26,6 +26,7 @@
 #include "dynid/ingest/run_processor.hpp"
 #include "dynid/server/server.hpp"
 #include "ingest_test_support.hpp"
+#include "temp_dir.hpp"
 
 namespace dynid::e2e {
 
@@ -34,16 +35,7 @@ using namespace std::chrono_literals;
 inline constexpr dds_domainid_t kDomain = 23;
 inline constexpr std::chrono::milliseconds kPatience = 15s;  // discovery and folding under load
 
-class TempDir {
- public:
-  TempDir();
-  ~TempDir();
-  const std::filesystem::path& path() const { return path_; }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
+using ::dynid::test::TempDir;
 
 /// deploy/cyclonedds/loopback.xml plus this process's discovery tag (without the tag after
 /// use_open_network()).

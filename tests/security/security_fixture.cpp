@@ -55,17 +55,6 @@ std::string read_text(const std::filesystem::path& file) {
   return text.str();
 }
 
-TempDir::TempDir() {
-  std::string pattern = (std::filesystem::temp_directory_path() / "dynid-security-XXXXXX").string();
-  if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-  path_ = pattern;
-}
-
-TempDir::~TempDir() {
-  std::error_code ignored;
-  std::filesystem::remove_all(path_, ignored);
-}
-
 Outcome run(const std::vector<std::string>& argv, std::chrono::milliseconds timeout) {
   const TempDir scratch;  // one per call: calls may run on several threads at once
   const auto log = scratch.path() / "output";

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <dds/dds.h>
+#include "temp_dir.hpp"
 
 namespace dynid::security_test {
 
@@ -23,17 +24,7 @@ using namespace std::chrono_literals;
 
 inline constexpr dds_domainid_t kDomain = 29;
 
-class TempDir {
- public:
-  TempDir();
-  ~TempDir();
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
+using ::dynid::test::TempDir;
 
 /// What a finished program printed (stdout and stderr, interleaved) and its exit code
 /// (-1: killed at the deadline, or ended by a signal).

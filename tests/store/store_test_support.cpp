@@ -9,17 +9,6 @@
 
 namespace dynid::store::test {
 
-TempDir::TempDir() {
-  std::string pattern = (std::filesystem::temp_directory_path() / "dynid-store-XXXXXX").string();
-  if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-  path_ = pattern;
-}
-
-TempDir::~TempDir() {
-  std::error_code ignored;
-  std::filesystem::remove_all(path_, ignored);
-}
-
 ingest::RunAnnouncement announcement(const std::string& vehicle, const std::string& run) {
   ingest::RunAnnouncement a;
   a.vehicle = vehicle;

@@ -9,20 +9,11 @@
 #include "dynid/ingest/chunk.hpp"
 #include "dynid/ingest/run_announcement.hpp"
 #include "dynid/store/store.hpp"
+#include "temp_dir.hpp"
 
 namespace dynid::store::test {
 
-class TempDir {
- public:
-  TempDir();
-  ~TempDir();
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
+using ::dynid::test::TempDir;
 
 /// Three channels (speed, yaw rate, steering angle) at 100 Hz, one lateral_bicycle model.
 ingest::RunAnnouncement announcement(const std::string& vehicle, const std::string& run);
