@@ -5,45 +5,12 @@
 #include <dynid/input/ids.hpp>
 #include <dynid/input/number.hpp>
 
+#include "dynid/dds/protocol.hpp"
 #include "dynid/error.hpp"
 
 namespace dynid::server {
 
 namespace {
-
-struct KindSpec {
-  std::set<std::string> required;
-  std::set<std::string> optional;
-  std::set<std::string> repeatable;
-};
-
-const std::map<std::string, KindSpec>& kinds() {
-  static const std::map<std::string, KindSpec> specs{
-      {"vehicles", {{}, {"format"}, {}}},
-      {"runs", {{"vehicle"}, {"format"}, {}}},
-      {"estimate", {{"vehicle"}, {"run", "model", "format"}, {}}},
-      {"excitation", {{"vehicle"}, {"run", "format"}, {}}},
-      {"pooled", {{"vehicle", "run"}, {"model", "format"}, {"run"}}},
-      {"close", {{"vehicle", "run"}, {"format"}, {}}},
-      {"reprocess", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},
-      {"base", {{"vehicle", "run", "model"}, {"format"}, {}}},
-      {"residual", {{"vehicle", "run", "model"}, {"effects", "candidates", "format"}, {}}},
-      {"add-effect", {{"vehicle", "run", "model", "effect"}, {"effects", "reference", "format"}, {"reference"}}},
-      {"trace", {{"vehicle", "run", "model"}, {"effects", "reference", "rounds", "format"}, {"reference"}}},
-      {"consistency", {{"vehicle", "run"}, {"reference", "format"}, {"reference"}}},
-      {"iv", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},
-      {"simex", {{"vehicle", "run", "model"}, {"effects", "format"}, {}}},
-      {"status", {{}, {"format"}, {}}},
-      {"fleet", {{"model", "shared", "vehicles"}, {"format"}, {"shared"}}},
-  };
-  return specs;
-}
-
-std::string known_kinds() {
-  std::string list;
-  for (const auto& [name, spec] : kinds()) list += (list.empty() ? "" : ", ") + name;
-  return list;
-}
 
 // Vehicle ids and run names reach the store's queries, partitions and log lines: the id rule
 // (input/ids.hpp) is checked here, before any work.
@@ -83,30 +50,34 @@ std::vector<std::string> ParsedRequest::all(const std::string& name) const {
 ParsedRequest parse_request(const dds::Request& request) {
   const std::string where =
       "request " + input::printable(request.client) + "#" + std::to_string(request.correlation_id);
-  const auto spec = kinds().find(request.kind);
-  if (spec == kinds().end())
-    throw InputError(where + ": unknown kind '" + input::printable(request.kind) + "' (known: " + known_kinds() + ")");
+  const dds::protocol::RequestKind* spec = dds::protocol::find_request_kind(request.kind);
+  if (spec == nullptr)
+    throw InputError(where + ": unknown kind '" + input::printable(request.kind) +
+                     "' (known: " + dds::protocol::request_kind_names() + ")");
   ParsedRequest parsed{request.kind, {}};
   for (const auto& argument : request.arguments) {
-    const auto& s = spec->second;
-    if (!s.required.count(argument.name) && !s.optional.count(argument.name))
-      throw InputError(where + ": '" + request.kind + "' takes no argument '" + input::printable(argument.name) + "'");
+    if (!spec->takes(argument.name))
+      throw InputError(where + ": '" + request.kind + "' takes no argument '" +
+                       input::printable(argument.name) + "'");
     if (argument.value.empty())
       throw InputError(where + ": argument '" + argument.name + "' is empty");
     auto& values = parsed.arguments[argument.name];
-    if (!values.empty() && !s.repeatable.count(argument.name))
+    if (!values.empty() && !spec->is_repeatable(argument.name))
       throw InputError(where + ": argument '" + argument.name + "' given twice");
     values.push_back(argument.value);
   }
-  for (const auto& name : spec->second.required)
+  // In name order, so that the first missing one named does not depend on the table's order.
+  std::set<std::string> required(spec->required.begin(), spec->required.end());
+  for (const auto& name : required)
     if (!parsed.arguments.count(name))
       throw InputError(where + ": '" + request.kind + "' needs argument '" + name + "'");
   check_ids(parsed, where);
   // The residual loop's reports come as text, JSON or a self-contained HTML page.
-  const bool report = request.kind == "residual" || request.kind == "add-effect" || request.kind == "trace";
+  const bool report = spec->html_reply;
   if (const auto format = parsed.optional("format");
       format && *format != "text" && *format != "json" && !(report && *format == "html"))
-    throw InputError(where + ": format '" + *format + "' is neither text nor json" + (report ? " nor html" : ""));
+    throw InputError(where + ": format '" + *format + "' is neither text nor json" +
+                     (report ? " nor html" : ""));
   return parsed;
 }
 

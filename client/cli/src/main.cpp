@@ -11,13 +11,14 @@
 // id or run name that breaks the id rule of dynid/input/ids.hpp), 3 not found, 4 the server failed (or
 // the servers disagree on the shard count), 5 no server answered in time, 6 some shards did
 // not answer (the output holds the others').
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <sstream>
-#include <unistd.h>
+#include <stdexcept>
 
 #include <dynid/options/option_checks.hpp>
 
@@ -25,6 +26,7 @@
 #include "dynid/cli/shard_replies.hpp"
 #include "dynid/cli/watch_view.hpp"
 #include "dynid/dds/conversions.hpp"
+#include "dynid/dds/protocol.hpp"
 #include "dynid/dds/topics.hpp"
 #include "dynid/report/estimate_report.hpp"
 
@@ -86,7 +88,22 @@ int request_all(const Common& c, dynid::cli::RequestClient& client, const std::s
   return 6;
 }
 
+// The requests follow the protocol's table (dynid/dds/protocol.hpp), the one the server checks
+// them against: a kind or an argument it does not list is this program's bug, said so before
+// anything is sent.
+void check_against_protocol(const std::string& kind,
+                            const std::vector<RequestArgument>& arguments) {
+  const auto* spec = dynid::dds::protocol::find_request_kind(kind);
+  if (spec == nullptr)
+    throw std::logic_error("internal error: request kind '" + kind + "' is not in the protocol");
+  for (const auto& argument : arguments)
+    if (!spec->takes(argument.name))
+      throw std::logic_error("internal error: '" + kind + "' takes no argument '" + argument.name +
+                             "'");
+}
+
 int request(const Common& c, const std::string& kind, std::vector<RequestArgument> arguments) {
+  check_against_protocol(kind, arguments);
   dynid::dds::Participant participant({c.domain, dynid::dds::config_uri(c.config)});
   dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
   if (kind == "vehicles" || kind == "status") return request_all(c, client, kind);
@@ -98,6 +115,7 @@ int request(const Common& c, const std::string& kind, std::vector<RequestArgumen
 int report_request(const Common& c, const std::string& kind, const std::vector<RequestArgument>& arguments,
                    const std::string& html_file) {
   if (html_file.empty()) return request(c, kind, arguments);
+  check_against_protocol(kind, arguments);
   dynid::dds::Participant participant({c.domain, dynid::dds::config_uri(c.config)});
   dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
   const dynid::dds::Reply reply = client.call(kind, arguments, timeout_of(c));
