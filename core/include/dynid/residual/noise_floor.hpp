@@ -1,68 +1,25 @@
 #pragma once
 // NoiseFloor: how large a model's residual is when the model lacks nothing, so that the residual
-// loop can say "adequate: the residual is at the noise floor" before it hunts for effects.
+// loop can say "adequate: the residual is at the noise floor" before it hunts for effects. The
+// argument behind each step, with what was measured: docs/decisions/noise-floor.md.
 //
-// 1. Channel noise (measure_channel_noise): for every announced channel that is low-passed, the
-//    power spectral density of its raw samples just above the cut-off (Welch: Hann windows of
-//    256 samples, half overlapping, over every valid segment, the bins from 1.5 to 3 times the
-//    cut-off, below 0.9 Nyquist), taken on raw - low-passed raw so that the slow content cannot
-//    leak into the band. Above the cut-off a channel holds only its noise (DYCARO's choice of the
-//    cut-off). The level inside the band the model sees is extrapolated from there: a noise
-//    spectrum is even in f and smooth near 0, so its log is a + b f^2, fitted over the bins; the
-//    in-band level is the mean of exp(a + b f^2) over [0, fc] (a channel interpolated from a
-//    slower message falls off as sinc^4, that shape to second order; interpolation between
-//    frames tilts even white sensor noise, so the slope is always kept, its variance counted).
-//    Reported as the white-noise std at the grid
-//    rate with that level, sigma^2 = PSD fs / 2. Why not the whole power above the cut-off: a
-//    channel sent slower than the grid and interpolated onto it (a 42 Hz message on a 100 Hz
-//    grid) has most of its noise power at low frequency; its power above the cut-off, spread as
-//    white noise, understates the noise in the band by half or more.
-//    The profile may declare a channel's noise instead (source "declared").
-// 2. The floor (noise_floor): the noise carried through the product's own path, not through a
-//    formula. For each channel in turn, `draws` copies of the raw run with fresh white noise of
-//    that channel's sigma on that channel are preprocessed as the server does and the model's
-//    rows built on the declared model's own rows; the difference of their residual, fitted
-//    again, from the run's own is that channel's share of the residual. Fitted again, not at
-//    the run's solution: a noisy regressor attenuates its parameters (errors in variables) and
-//    leaves a slow part of the signal in the residual, second order in the noise, which the
-//    run's residual holds; the block tests (4.) see it (on a synthetic exact model, sums over
-//    1.3 s were 1.6 times the floor without the refit, 0.9 with it, measured). The
-//    floor's mean square is the sum of the shares (independent sensors); its autocorrelation
-//    gives the effective number of rows of a mean square, n / (1 + 2 sum_k rho_k^2) (Bartlett).
-//    Linear in the noise to first order: exact for the model's linear channels, a linearisation
-//    for v^2 and the like. A channel the model does not read changes nothing and costs one draw.
-// 3. The test, per equation group: r = residual mean square / floor mean square. Under "the model
-//    lacks nothing", log r is about normal with variance 2 / n_eff (the residual's mean square,
-//    chi2(n_eff) / n_eff) plus the floor's own relative variance: each share's sigma^2 as
-//    measured (a bootstrap over the measurement's windows) and the draws' (2 / (draws n_eff)).
-//    At the floor unless log r exceeds the normal quantile 1 - error_rate / groups of that. So
-//    a model that lacks nothing is called inadequate with probability about error_rate, with
-//    the floor's uncertainty counted, whatever the car's noise levels.
-// 4. The same test at longer time scales (whiteness, judged against the floor's own colour),
-//    reported beside the verdict, not in it: the rows are low-passed and differentiated, so the
-//    residual of a model that lacks nothing is not white, and a white-noise bound on its
-//    autocorrelation flags nearly every clean run (12 of 20 on bench/trace, measured). What a
-//    model that lacks nothing must match is the floor's autocorrelation, and the sum of the
-//    residual over a block of L consecutive decimated rows weighs it: E(sum^2) = the sum of the
-//    autocovariance over the block's pairs. Per group and L in kBlockRows (4, 16, 64 rows:
-//    frequencies below about cut-off / L), the statistic is sum_blocks (block sum of the
-//    residual)^2 over the same sum for the floor's draws (the same blocks, so gaps and segment
-//    edges count alike); its log is about normal with variance 2 / (effective blocks) plus the
-//    floor's relative variance, as in 3., at error_rate over the groups and the scales
-//    (Bonferroni). A scale with fewer than kMinBlocks blocks is not tested. A missing effect is
-//    slow next to the noise the cut-off leaves: its share of a block sum grows as L^2, the
-//    noise's as L. Why not in the verdict (tried, measured): on bench/trace it found more (16 of
-//    18 families; a head wind named linear_drag in 4 of 5 runs instead of "inseparable", an ECU
-//    torque over-reading with engine speed in 3 of 5 instead of 1), at the same false-alarm rate
-//    (1 in 160 clean runs), but on our own simulator it called 2 of 5 clean sine steers of the
-//    lateral model inadequate (the bicycle model's slow misfit of a car that rolls and transfers
-//    load: sums over 1.3 s at 2.4 and 3.0 times the floor) and an unmeasured grade only partly
-//    explained by a road profile whose 100 m knots cannot follow it. Given data enough, a test
-//    this strict rejects every approximate model; it can decide once the loop states how large a
-//    slow misfit must be to matter (its share of the residual), which it does not yet.
-//// Limits (said in the report): signal content above the cut-off counts as noise (the floor
-// rises, a small missing effect can hide); noise that is not flat across the cut-off (a sensor
-// whose own filter sits just below it) is misjudged.
+// 1. measure_channel_noise: each low-passed channel's noise, from the PSD of raw - low-passed
+//    raw in [1.5, 3] x cut-off (Hann windows of max(32, 8 x odmf) samples, half overlapping,
+//    per bin the median over the windows / ln 2), extrapolated into the band the model sees
+//    (log PSD = a + b f^2) and reported as the white-noise std at the grid rate. A profile may
+//    declare a channel's noise instead (source "declared").
+// 2. noise_floor: each channel's share of the residual, carried through the product's own path:
+//    `draws` copies of the raw run with fresh noise of that channel's sigma, preprocessed as the
+//    server does, rows built and fitted again; the floor is the sum of the shares, with its
+//    autocorrelation (the effective number of rows of a mean square, Bartlett).
+// 3. The verdict per equation group: log(residual mean square / floor mean square) against the
+//    normal quantile 1 - error_rate / groups, its variance the residual's (2 / n_eff) plus the
+//    floor's own (measurement bootstrap, draws). A model that lacks nothing is called
+//    inadequate with probability about error_rate.
+// 4. Block sums of 4, 16 and 64 decimated rows against the floor's (slow structure), reported
+//    beside the verdict, not in it.
+// Limits (said in the report): signal content above the cut-off counts as noise; noise that is
+// not flat across the cut-off is misjudged.
 #include <cstdint>
 #include <map>
 #include <string>

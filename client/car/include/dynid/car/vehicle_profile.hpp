@@ -4,80 +4,8 @@
 // (docs/CHANNELS.md) in SI units, the vehicle's constants and model list for the server, and the
 // spool. Profiles, not code, describe a car.
 //
-// Format (deploy/profiles/rav4.toml is a complete example):
-//
-//   [vehicle]
-//   id = "rav4-2017"
-//   dbc = "../../dbc/toyota.dbc"       # relative to this profile file
-//   interfaces = ["can0"]              # optional: frames from other buses are ignored
-//   [grid]
-//   rate_hz = 50.0                     # uniform grid of every run, at most 10 kHz
-//   chunk_seconds = 1.0                # a whole number of grid periods, at most 10000 rows
-//   max_gap_periods = 2.5              # optional (1..3600): see resampler.hpp
-//   max_time_jump = 10.0               # optional (seconds, at most 3600): a jump of the frames'
-//                                      # clock, or a bus silence, longer than this ends the
-//                                      # grid piece (source_clock.hpp, resampler.hpp)
-//   [spool]
-//   directory = "spool"                # relative to this profile file unless absolute
-//   max_bytes = 1073741824
-//   [constants]                        # SI, shared by every model
-//   wheel_radius = 0.33
-//   [[models]]
-//   name = "longitudinal_engine"       # model registry name
-//   effects = ["road_grade"]           # optional
-//   constants = { driveline_efficiency = 0.9 }   # optional, added to / override [constants]
-//   [preprocessing]                    # optional; every key defaults to the server's (DYCARO's)
-//   butterworth_order = 5              # zero-phase low-pass order, 1..8
-//   cut_off_hz = 5.0                   # -3 dB, below rate_hz / 2; absent: 0.8 rate_hz / (2 odmf)
-//   odmf = 8                           # rows on every odmf-th grid sample (decimation), 1..1000
-//   noise = { ax = 0.05 }              # declared sensor noise std per channel (its SI unit),
-//                                      # used by the residual loop's noise floor instead of
-//                                      # measuring it above the cut-off
-//   [[channels]]
-//   name = "vx"                        # catalogue channel; its SI unit comes from the catalogue
-//   message = "WHEEL_SPEEDS"           # DBC message name
-//   signals = ["WHEEL_SPEED_FL", "WHEEL_SPEED_FR", "WHEEL_SPEED_RL", "WHEEL_SPEED_RR"]
-//   combine = "mean"                   # "sum" (default) or "mean" of the converted signals
-//   # optional: signal = "X" (one signal), dbc_unit = "bar" (when the DBC has none or a wrong
-//   # one), factor/offset (explicit DBC -> SI conversion instead of the unit table), scale and
-//   # divide_by (a number or the name of a [constants] entry, e.g. "steering_ratio"),
-//   # sign = -1, max_gap (seconds, at most 3600, instead of the derived window),
-//   # interpolation = "cubic" (a smooth signal on a slower message: the grid's values between
-//   # frames without linear interpolation's attenuation; "linear", the default, for a signal that
-//   # steps, resampler.hpp).
-//
-//   [[sources]]                        # optional: auxiliary sources besides the bus (auxiliary.hpp)
-//   name = "recorder_imu"              # the id rule (input/ids.hpp); dynid-car --source NAME=FILE
-//   type = "csv"                       # a time-stamped CSV file, one header line
-//   file = "imu.csv"                   # optional, relative to this profile; --source overrides
-//   time_column = "t"
-//   time_unit = "s"                    # s, ms, us or ns
-//   clock = { offset = 0.0 }           # bus time = source time + offset (seconds), or
-//   clock = { estimate_from = "ax", reference = "ax", max_offset = 2.0, reference_derivative = false }
-//   wait = 1.0                         # live runs: seconds the bus may wait for this source's
-//                                      # rows (live_merge.hpp), at most 30
-//   [[sources.channels]]
-//   column = "ax"                      # a column of the header
-//   channel = "ax"                     # catalogue channel
-//   unit = "m/s^2"                     # required: the column's unit, converted to the channel's
-//   # optional: scale, sign = -1, max_gap (as for bus channels), replaces_bus = true (the bus
-//   # mapping of this channel gives way when the source is given for a run)
-//   # A GNSS/INS pose in ECEF (WGS84) gives derived channels (ecef.hpp):
-//   ecef = { position = ["x", "y", "z"], velocity = ["vx", "vy", "vz"] }   # m and m/s columns
-//   [[sources.channels]]
-//   derived = "grade"                  # the path's slope (rad; none below 1 m/s), or "speed" (m/s)
-//   channel = "road_grade"             # a channel of that unit; no column, no unit
-//   [[sources]]                        # a second CAN log (candump, ASC, BLF) with its own DBC
-//   name = "chassis"
-//   type = "can"
-//   dbc = "chassis.dbc"                # relative to this profile
-//   interfaces = ["can1"]              # optional, as [vehicle] interfaces
-//   file = "chassis.blf"               # optional; --source chassis=FILE
-//   clock = { offset = 0.0 }           # as above
-//   [[sources.channels]]               # written as [[channels]] are, plus replaces_bus
-//   name = "roll_rate"
-//   message = "IMU2"
-//   signal = "RollRate"
+// The format, every key with its limits, and what is refused: docs/PROFILES.md
+// (deploy/profiles/rav4.toml is a complete example).
 //
 // Value of a channel sample: sign * scale / divide_by * combine_i(conv_i(dbc_value_i)), where
 // conv_i converts signal i from its DBC unit to the channel's SI unit. All signals of a channel
