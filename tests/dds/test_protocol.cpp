@@ -26,7 +26,8 @@ TEST(Protocol, EveryKindIsAcceptedWithItsRequiredArguments) {
   for (const RequestKind& kind : request_kinds()) {
     const server::ParsedRequest parsed = server::parse_request(request_of(kind));
     EXPECT_EQ(parsed.kind, kind.name);
-    for (const auto& name : kind.required) EXPECT_TRUE(parsed.optional(name).has_value()) << kind.name;
+    for (const auto& name : kind.required)
+      EXPECT_TRUE(parsed.optional(name).has_value()) << kind.name;
   }
 }
 
@@ -43,7 +44,8 @@ TEST(Protocol, EveryOptionalArgumentIsAcceptedAndNoOtherOne) {
       server::parse_request(r);
       ADD_FAILURE() << kind.name << " took an argument its table does not list";
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("takes no argument 'no-such-argument'"), std::string::npos)
+      EXPECT_NE(std::string(e.what()).find("takes no argument 'no-such-argument'"),
+                std::string::npos)
           << e.what();
     }
   }
@@ -77,8 +79,9 @@ TEST(Protocol, HtmlOnlyWhereTheKindAnswersWithAPage) {
 
 TEST(Protocol, KindsAreSortedAndUniqueAndUnknownOnesAreRefusedWithTheList) {
   const auto& kinds = request_kinds();
-  EXPECT_TRUE(std::is_sorted(kinds.begin(), kinds.end(),
-                             [](const RequestKind& a, const RequestKind& b) { return a.name < b.name; }));
+  EXPECT_TRUE(
+      std::is_sorted(kinds.begin(), kinds.end(),
+                     [](const RequestKind& a, const RequestKind& b) { return a.name < b.name; }));
   std::set<std::string> names;
   for (const auto& kind : kinds) EXPECT_TRUE(names.insert(kind.name).second) << kind.name;
   EXPECT_EQ(find_request_kind("no-such-kind"), nullptr);
@@ -86,7 +89,8 @@ TEST(Protocol, KindsAreSortedAndUniqueAndUnknownOnesAreRefusedWithTheList) {
     server::parse_request({"tester", 2, "no-such-kind", {}});
     ADD_FAILURE() << "an unknown kind was accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("(known: " + request_kind_names() + ")"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("(known: " + request_kind_names() + ")"),
+              std::string::npos)
         << e.what();
   }
 }
