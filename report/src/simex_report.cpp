@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cells.hpp"
+#include "dynid/error.hpp"
 
 namespace dynid::report {
 namespace {
@@ -20,17 +21,17 @@ double correction_z(const residual::SimexFit& f, Eigen::Index j) {
   return f.std(j) > 0.0 ? (f.value(j) - f.ls_value(j)) / f.std(j) : std::nan("");
 }
 
-// Where the bias test keeps least squares: SIMEX wherever it corrected and estimates the parameter
-// (residual/publication.hpp; the rule also requires the row identified).
-bool simex_published(const residual::SimexFit& f, Eigen::Index j) { return f.corrected() && std::isfinite(f.value(j)); }
-
-const char* published(const residual::SimexFit& f, Eigen::Index j) {
-  return simex_published(f, j) ? "SIMEX" : "least squares";
+void check_flags(const residual::SimexFit& f, const std::vector<bool>& by_simex) {
+  if (by_simex.size() != f.parameters.size())
+    throw InputError("SIMEX report: " + std::to_string(by_simex.size()) +
+                     " publication flags for " + std::to_string(f.parameters.size()) +
+                     " parameters of " + f.model);
 }
 
 }  // namespace
 
-std::string format_simex_text(const residual::SimexFit& f) {
+std::string format_simex_text(const residual::SimexFit& f, const std::vector<bool>& by_simex) {
+  check_flags(f, by_simex);
   std::string out = fmt::format("SIMEX: {} (effects: {})\n", f.model,
                                 f.effects.empty() ? "none" : fmt::format("{}", fmt::join(f.effects, ", ")));
   if (!f.corrected()) return out + "  verdict: " + f.statement() + "\n";
@@ -43,17 +44,20 @@ std::string format_simex_text(const residual::SimexFit& f) {
   for (std::size_t k = 0; k < f.parameters.size(); ++k) {
     const auto j = static_cast<Eigen::Index>(k);
     const double z = correction_z(f, j);
-    out += fmt::format("  {:<26} {:<10} {:>13} {:>11} {:>13} {:>11} {:>11} {:>11} {:>8}  {}\n", f.parameters[k].name,
-                       f.parameters[k].unit, number(f.ls_value(j)), number(f.ls_hac_std(j)), number(f.value(j)),
-                       number(f.std(j)), number(f.monte_carlo_std(j)), number(f.level_std(j)),
-                       std::isfinite(z) ? fmt::format("{:+.2f}", z) : "-", published(f, j));
+    out += fmt::format("  {:<26} {:<10} {:>13} {:>11} {:>13} {:>11} {:>11} {:>11} {:>8}  {}\n",
+                       f.parameters[k].name, f.parameters[k].unit, number(f.ls_value(j)),
+                       number(f.ls_hac_std(j)), number(f.value(j)), number(f.std(j)),
+                       number(f.monte_carlo_std(j)), number(f.level_std(j)),
+                       std::isfinite(z) ? fmt::format("{:+.2f}", z) : "-",
+                       by_simex[k] ? "SIMEX" : "least squares");
   }
   out += "  published: SIMEX for every identified parameter; where the bias test sends the model to IV (dynid iv), "
          "SIMEX only if Hausman's comparison with IV lets it stand (dynid estimates says which)\n";
   return out + "  verdict: " + f.statement() + "\n";
 }
 
-std::string simex_json(const residual::SimexFit& f) {
+std::string simex_json(const residual::SimexFit& f, const std::vector<bool>& by_simex) {
+  check_flags(f, by_simex);
   nlohmann::json parameters = nlohmann::json::array();
   for (std::size_t k = 0; k < f.parameters.size(); ++k) {
     const auto j = static_cast<Eigen::Index>(k);
@@ -66,7 +70,7 @@ std::string simex_json(const residual::SimexFit& f) {
                           {"monte_carlo_std", finite(f.monte_carlo_std(j))},
                           {"level_std", finite(f.level_std(j))},
                           {"correction_z", finite(correction_z(f, j))},
-                          {"simex_published", simex_published(f, j)}});
+                          {"simex_published", static_cast<bool>(by_simex[k])}});
   }
   return nlohmann::json{{"model", f.model},
                         {"effects", f.effects},

@@ -6,13 +6,15 @@
 #include "dynid/ingest/recorded_run.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/report/iv_report.hpp"
-#include "dynid/report/simex_report.hpp"
 #include "dynid/report/residual_html.hpp"
 #include "dynid/report/residual_report.hpp"
-#include "dynid/residual/effect_comparison.hpp"
+#include "dynid/report/simex_report.hpp"
 #include "dynid/residual/consistency.hpp"
 #include "dynid/residual/diagnosis.hpp"
+#include "dynid/residual/effect_comparison.hpp"
 #include "dynid/residual/effect_screen.hpp"
+#include "dynid/residual/model_fit.hpp"
+#include "dynid/residual/publication.hpp"
 #include "dynid/residual/trace.hpp"
 
 namespace dynid::server {
@@ -77,6 +79,22 @@ ResidualReply consistency_reply(const ingest::RunAnnouncement& announcement, con
   return {report::format_consistency_text(c, left_out), "text/plain"};
 }
 
+// The rows SIMEX publishes where the bias test keeps least squares: the publication rule's own
+// answer (residual/publication.hpp) without an IV fit.
+std::vector<bool> simex_rows_where_least_squares_stands(
+    const model::Model& model, const std::vector<std::string>& effects,
+    const residual::SimexFit& simex, const std::vector<ingest::PreprocessedSegment>& segments,
+    double rate, int odmf) {
+  residual::FitOptions options;
+  options.series = false;
+  const residual::ModelFit ls = residual::fit_model(model, effects, segments, rate, odmf, options);
+  const residual::Publication p =
+      residual::publish(ls.parameters, ls.estimate, ls.column_norms, nullptr, &simex);
+  if (p.estimator != residual::PublishedEstimator::kSimex)
+    return std::vector<bool>(ls.parameters.size(), false);
+  return p.replaced;
+}
+
 }  // namespace
 
 ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
@@ -105,8 +123,10 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
   }
   if (request.kind == "simex") {  // the live judgement's fit (same noise, same draws), on demand
     const residual::SimexFit fit = simex_of(*model, declared, run, segments, run_noise(run, segments));
-    if (request.format == "json") return {report::simex_json(fit), "application/json"};
-    return {report::format_simex_text(fit), "text/plain"};
+    const std::vector<bool> by_simex =
+        simex_rows_where_least_squares_stands(*model, declared, fit, segments, rate, odmf);
+    if (request.format == "json") return {report::simex_json(fit, by_simex), "application/json"};
+    return {report::format_simex_text(fit, by_simex), "text/plain"};
   }
   if (request.kind == "trace") {
     residual::TraceOptions options;
