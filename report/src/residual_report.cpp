@@ -290,7 +290,7 @@ json effect_series(const residual::ModelFit& after) {
   return out;
 }
 
-json comparison_object(const residual::EffectComparison& c) {
+json comparison_object(const residual::EffectComparison& c, bool series) {
   json parameters = json::array();
   for (const residual::ParameterChange& p : c.parameters)
     parameters.push_back({{"name", p.name},
@@ -304,19 +304,22 @@ json comparison_object(const residual::EffectComparison& c) {
                           {"error_after_percent", finite(p.error_after_percent())},
                           {"status_before", p.status_before ? json(ls::to_string(*p.status_before)) : json(nullptr)},
                           {"status_after", ls::to_string(p.status_after)}});
-  return {{"effect", c.effect},
-          {"parameters", parameters},
-          {"groups_before", fit_groups(c.before)},
-          {"groups_after", fit_groups(c.after)},
-          {"in_sample_drop", finite(c.in_sample_drop())},
-          {"held_out_drop", finite(c.held_out_drop())},
-          {"effect_series", effect_series(c.after)}};
+  json out{{"effect", c.effect},
+           {"parameters", parameters},
+           {"groups_before", fit_groups(c.before)},
+           {"groups_after", fit_groups(c.after)},
+           {"in_sample_drop", finite(c.in_sample_drop())},
+           {"held_out_drop", finite(c.held_out_drop())}};
+  if (series) out["effect_series"] = effect_series(c.after);
+  return out;
 }
 
 }  // namespace
 
 std::string diagnosis_json(const residual::Diagnosis& d) { return diagnosis_object(d).dump(); }
-std::string comparison_json(const residual::EffectComparison& c) { return comparison_object(c).dump(); }
+std::string comparison_json(const residual::EffectComparison& c, bool series) {
+  return comparison_object(c, series).dump();
+}
 
 std::string consistency_json(const residual::Consistency& c, const std::vector<std::string>& left_out) {
   json comparisons = json::array();
@@ -352,12 +355,12 @@ std::string consistency_json(const residual::Consistency& c, const std::vector<s
       .dump();
 }
 
-std::string trace_json(const residual::Trace& t) {
+std::string trace_json(const residual::Trace& t, bool series) {
   json rounds = json::array();
   for (const residual::TraceRound& r : t.rounds)
     rounds.push_back({{"effects", r.effects},
                       {"diagnosis", diagnosis_object(r.diagnosis)},
-                      {"added", r.added ? comparison_object(*r.added) : json(nullptr)}});
+                      {"added", r.added ? comparison_object(*r.added, series) : json(nullptr)}});
   return json{{"model", t.model}, {"declared", t.declared}, {"rounds", rounds}, {"added", t.added()},
               {"stopped", t.stopped}}
       .dump();

@@ -1,6 +1,9 @@
 #include "dynid/server/residual_requests.hpp"
 
 #include <algorithm>
+#include <map>
+#include <memory>
+#include <set>
 
 #include "dynid/error.hpp"
 #include "dynid/ingest/recorded_run.hpp"
@@ -28,6 +31,30 @@ const ingest::ModelSpec& announced_model(const ingest::RunAnnouncement& a, const
   throw InputError("run " + a.vehicle + "/" + a.run + " has no model '" + model + "' (its models: " + known + ")");
 }
 
+// A reference value must name a parameter that a model of the request has, declared or through
+// one of its candidate effects: a misspelt name would otherwise be ignored and the report would
+// print no error where the engineer expects one.
+void check_reference_names(const std::map<std::string, double>& reference,
+                           const std::vector<std::unique_ptr<model::Model>>& models) {
+  std::set<std::string> known;
+  std::string owners;
+  for (const auto& m : models) {
+    for (const model::ParameterInfo& p : m->parameters()) known.insert(p.name);
+    for (const model::Effect& e : m->candidate_effects())
+      for (const model::ParameterInfo& p : e.parameters) known.insert(p.name);
+    owners += (owners.empty() ? "" : ", ") + m->name();
+  }
+  std::string unknown;
+  for (const auto& entry : reference)
+    if (known.count(entry.first) == 0)
+      unknown += (unknown.empty() ? "'" : ", '") + entry.first + "'";
+  if (unknown.empty()) return;
+  std::string names;
+  for (const auto& name : known) names += (names.empty() ? "" : ", ") + name;
+  throw InputError("--reference " + unknown + ": no parameter of " + owners +
+                   " or their effects has this name (" + names + ")");
+}
+
 }  // namespace
 
 namespace {
@@ -42,8 +69,9 @@ ResidualReply diagnosis_reply(const residual::Diagnosis& d, const std::string& t
   return {report::format_diagnosis_text(d), "text/plain"};
 }
 
-ResidualReply trace_reply(const residual::Trace& t, const std::string& title, const std::string& format) {
-  if (format == "json") return {report::trace_json(t), "application/json"};
+ResidualReply trace_reply(const residual::Trace& t, const std::string& title,
+                          const std::string& format, bool series) {
+  if (format == "json") return {report::trace_json(t, series), "application/json"};
   if (format == "html") {
     const residual::TraceRound* last_added = nullptr;
     for (const residual::TraceRound& r : t.rounds)
@@ -105,6 +133,16 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
     throw InputError("trace: rounds " + std::to_string(request.rounds) + " (0 to 10)");
   if ((request.kind == "consistency" || request.kind == "iv" || request.kind == "simex") && request.format == "html")
     throw InputError(request.kind + " report: format 'html' (text or json)");
+  std::vector<std::unique_ptr<model::Model>> models;
+  for (const ingest::ModelSpec& spec : announcement.models)
+    if (request.kind == "consistency" || spec.model == request.model) try {
+        models.push_back(model::make_model(spec.model, spec.constants));
+      } catch (const InputError&) {
+        if (request.kind != "consistency") throw;  // consistency names the models it leaves out
+      }
+  if (request.kind != "consistency" && models.empty())
+    announced_model(announcement, request.model);  // names the models
+  check_reference_names(request.reference, models);
   const ingest::RecordedRun run = ingest::assemble_run(announcement, chunks);
   const auto segments = ingest::preprocess_offline(run);
   if (segments.empty())
@@ -133,7 +171,8 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
     options.max_rounds = request.rounds;
     options.reference = request.reference;
     options.diagnosis.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
-    return trace_reply(residual::trace(*model, declared, run, options), title, request.format);
+    return trace_reply(residual::trace(*model, declared, run, options), title, request.format,
+                       request.series);
   }
   if (request.effect.empty()) {
     residual::DiagnosisOptions options;
@@ -143,7 +182,8 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
   }
   const residual::EffectComparison cmp =
       residual::compare_effect(*model, declared, request.effect, segments, rate, odmf, {}, request.reference);
-  if (request.format == "json") return {report::comparison_json(cmp), "application/json"};
+  if (request.format == "json")
+    return {report::comparison_json(cmp, request.series), "application/json"};
   if (request.format == "html") return {report::residual_html({title, nullptr, &cmp}), "text/html"};
   return {report::format_comparison_text(cmp), "text/plain"};
 }

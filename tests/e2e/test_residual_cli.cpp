@@ -103,6 +103,18 @@ TEST(E2eResidualCli, DiagnosesAndTracesInTextAndJson) {
   EXPECT_FALSE(t.at("rounds").empty());
   EXPECT_FALSE(t.at("stopped").get<std::string>().empty());
   EXPECT_EQ(t.at("rounds").size(), t.at("added").size() + 1);
+  // Row-by-row series only when asked: without --series no round carries them, with it every
+  // added round does.
+  args.push_back("--series");
+  const auto with_series = dynid(args);
+  ASSERT_EQ(with_series.exit_code, 0) << with_series.err;
+  const auto ts = nlohmann::json::parse(with_series.out);
+  ASSERT_EQ(ts.at("rounds").size(), t.at("rounds").size());
+  for (std::size_t k = 0; k < t.at("rounds").size(); ++k) {
+    if (t["rounds"][k]["added"].is_null()) continue;
+    EXPECT_FALSE(t["rounds"][k]["added"].contains("effect_series")) << "round " << k;
+    EXPECT_TRUE(ts["rounds"][k]["added"].contains("effect_series")) << "round " << k;
+  }
 
   args = {"trace"};
   args.insert(args.end(), where.begin(), where.end());
@@ -110,6 +122,19 @@ TEST(E2eResidualCli, DiagnosesAndTracesInTextAndJson) {
   const auto bad = dynid(args);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("expected name=value"), std::string::npos) << bad.err;
+  // A name no parameter has is refused and named, never silently ignored.
+  args = {"trace"};
+  args.insert(args.end(), where.begin(), where.end());
+  args.insert(args.end(), {"--reference", "sensor_scale=1.0", "--reference", "sensor_scael=1.0"});
+  const auto misspelt = dynid(args);
+  EXPECT_EQ(misspelt.exit_code, 2) << misspelt.out;
+  EXPECT_NE(misspelt.err.find("'sensor_scael'"), std::string::npos) << misspelt.err;
+  EXPECT_NE(misspelt.err.find("sensor_scale)"), std::string::npos)
+      << "the known names are listed: " << misspelt.err;
+  const auto misspelt_consistency = dynid(
+      {"consistency", "--vehicle", "trace-car", "--run", "run-t", "--reference", "mas=1457.5"});
+  EXPECT_EQ(misspelt_consistency.exit_code, 2) << misspelt_consistency.out;
+  EXPECT_NE(misspelt_consistency.err.find("'mas'"), std::string::npos) << misspelt_consistency.err;
   args = {"trace"};
   args.insert(args.end(), where.begin(), where.end());
   args.insert(args.end(), {"--rounds", "99"});

@@ -103,7 +103,7 @@ with tempfile.TemporaryDirectory(prefix="dynid-rav4-aux-") as tmp:
         origin = float(origin.group(1))
 
         trace_cmd = [cli_bin, "--cyclone-config", config, "--domain", DOMAIN, "--json", "trace", "--vehicle", "rav4-2017", "--run", "seg40",
-                     "--model", "kinematic_longitudinal"]
+                     "--model", "kinematic_longitudinal", "--series"]
         print("$ " + " ".join(trace_cmd))
         trace = subprocess.run(trace_cmd, capture_output=True, text=True, timeout=240)
         if trace.returncode != 0:

@@ -23,7 +23,7 @@ const std::vector<RequestKind>& request_kinds() {
   static const std::vector<RequestKind> kinds{
       {"add-effect",
        {"vehicle", "run", "model", "effect"},
-       {"effects", "reference", "format"},
+       {"effects", "reference", "series", "format"},
        {"reference"},
        true},
       {"base", {"vehicle", "run", "model"}, {"format"}, {}, false},
@@ -41,7 +41,7 @@ const std::vector<RequestKind>& request_kinds() {
       {"status", {}, {"format"}, {}, false},
       {"trace",
        {"vehicle", "run", "model"},
-       {"effects", "reference", "rounds", "format"},
+       {"effects", "reference", "rounds", "series", "format"},
        {"reference"},
        true},
       {"vehicles", {}, {"format"}, {}, false},

@@ -255,6 +255,10 @@ int main(int argc, char** argv) {
   add_effect_cmd->add_option("--html", html, "write the HTML report with plots to this file")
       ->check(dynid::input::output_file("HTML report"));
   add_effect_cmd->add_option("--reference", references, "a known value, name=value (repeat), e.g. mass=1457.5");
+  bool series = false;
+  const char* series_help =
+      "with --json: the added effect's fitted contribution row by row (effect_series)";
+  add_effect_cmd->add_flag("--series", series, series_help);
   std::string rounds;
   auto* trace_cmd = app.add_subcommand(
       "trace", "the residual loop: diagnose, add the effect that explains the residual, again (docs/RESIDUAL.md)");
@@ -264,6 +268,7 @@ int main(int argc, char** argv) {
   trace_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's; none: no effect)");
   trace_cmd->add_option("--reference", references, "a known value, name=value (repeat), e.g. mass=1457.5");
   trace_cmd->add_option("--rounds", rounds, "effects the loop may add (0 to 10, default 4)");
+  trace_cmd->add_flag("--series", series, series_help);
   trace_cmd->add_option("--html", html, "write the HTML report with plots to this file")
       ->check(dynid::input::output_file("HTML report"));
   auto* consistency_cmd = app.add_subcommand(
@@ -340,9 +345,15 @@ int main(int argc, char** argv) {
       // The server replays the run and fits it many times (the noise floor's draws, every
       // candidate, every round): longer than a table look-up on a long run.
       if (timeout->count() == 0) c.timeout_s = 120.0;
-      auto a = args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects},
-                     {"candidates", candidates}, {"effect", effect}, {"rounds", rounds},
-                     {"format", html.empty() ? "" : "html"}});
+      auto a = args({{"vehicle", vehicle},
+                     {"run", run},
+                     {"model", model},
+                     {"effects", effects},
+                     {"candidates", candidates},
+                     {"effect", effect},
+                     {"rounds", rounds},
+                     {"format", html.empty() ? "" : "html"},
+                     {"series", series ? "yes" : ""}});
       for (const auto& r : references) a.push_back({"reference", r});
       return report_request(c, *residual_cmd ? "residual" : (*add_effect_cmd ? "add-effect" : "trace"), a, html);
     }

@@ -12,7 +12,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double error_percent(double value, const std::optional<double>& truth) {
   if (!truth || *truth == 0.0 || !std::isfinite(value)) return kNaN;
-  return 100.0 * (value - *truth) / *truth;
+  return 100.0 * (value - *truth) /
+         std::abs(*truth);  // signed as the error, whatever the truth's sign
 }
 
 double drop(double before, double after) { return before > 0.0 ? 1.0 - after / before : 0.0; }

@@ -408,6 +408,22 @@ LocatedDelay delay_interval(const DelayProfile& p, double inflation) {
   return out;
 }
 
+// Why a located delay is no answer, or "": its interval reaches the edge of the search (the
+// best delay may lie beyond it, or the cost has no minimum: not a delay), or it holds zero (the
+// signal is not shown to be late or early at all).
+std::string not_located(const LocatedDelay& d, Eigen::Index max, double rate) {
+  const auto ms = [&](Eigen::Index samples) {
+    return std::to_string(std::llround(1000.0 * samples / rate));
+  };
+  const std::string interval =
+      "its 95 % interval of delays (" + ms(d.earliest) + " to " + ms(d.latest) + " ms)";
+  if (d.earliest <= -max || d.latest >= max)
+    return interval + " reaches the edge of the search (+-" + ms(max) + " ms): no delay located";
+  if (d.earliest <= 0 && d.latest >= 0)
+    return interval + " holds 0: the signal is not shown to be late or early";
+  return "";
+}
+
 std::string seconds_text(double t) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.10g", std::round(t * 1e6) / 1e6);
@@ -658,6 +674,11 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
     const CandidateScore along = score_delay(delays, channel, x_found, profile.samples);
     const double inflation = std::pow(along.coefficient_std / along.coefficient_textbook_std, 2);
     const LocatedDelay found = delay_interval(profile, inflation);
+    if (const std::string why = not_located(found, max, sample_rate_hz); !why.empty()) {
+      c.significant = false;  // the first-order column's misfit is no delay the search can name
+      c.note = why;
+      continue;
+    }
     rescore_with(c, delays, delay_effect_name(channel, found.samples, sample_rate_hz));
     c.effect = delay_effect_name(channel, found.samples, sample_rate_hz);
     // The delays are tried on the raw grid: a true delay between two samples rounds to one of

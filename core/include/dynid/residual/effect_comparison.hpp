@@ -25,7 +25,7 @@ struct ParameterChange {
   /// Statuses (model/parameter_status.hpp) in each fit; before: nullopt for the effect's own.
   std::optional<ls::ParameterStatus> status_before = std::nullopt;
   ls::ParameterStatus status_after = ls::ParameterStatus::kIdentified;
-  double error_before_percent() const;  ///< NaN without truth
+  double error_before_percent() const;  ///< 100 (value - truth) / |truth|; NaN without truth
   double error_after_percent() const;
 };
 

@@ -38,10 +38,12 @@ std::string format_trace_text(const residual::Trace& trace);
 /// models left out with the reason.
 std::string format_consistency_text(const residual::Consistency& consistency, const std::vector<std::string>& left_out);
 
-/// The same as JSON objects, for tools (nlohmann::json; NaN and infinities as null).
+/// The same as JSON objects, for tools (nlohmann::json; NaN and infinities as null). The added
+/// effect's fitted contribution row by row (`effect_series`: a run's worth of numbers) only with
+/// `series`; without, the key is absent.
 std::string diagnosis_json(const residual::Diagnosis& diagnosis);
-std::string comparison_json(const residual::EffectComparison& comparison);
-std::string trace_json(const residual::Trace& trace);
+std::string comparison_json(const residual::EffectComparison& comparison, bool series = false);
+std::string trace_json(const residual::Trace& trace, bool series = false);
 std::string consistency_json(const residual::Consistency& consistency, const std::vector<std::string>& left_out);
 
 }  // namespace dynid::report

@@ -49,6 +49,7 @@ struct ResidualRequest {
   std::string kind = "residual";                    ///< residual | add-effect | trace | consistency | iv
   std::map<std::string, double> reference;          ///< add-effect, trace, consistency
   int rounds = 4;                                   ///< trace only
+  bool series = false;  ///< json of add-effect and trace: the added effect's series row by row
 };
 
 struct ResidualReply {
