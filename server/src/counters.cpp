@@ -27,6 +27,7 @@ constexpr std::array<Field, dds::protocol::kServerCounters.size()> kFieldList{{
     &CounterSnapshot::requests_rejected,
     &CounterSnapshot::not_owned,
     &CounterSnapshot::store_errors,
+    &CounterSnapshot::requests_cancelled,
 }};
 
 }  // namespace

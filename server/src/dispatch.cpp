@@ -2,7 +2,9 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
+#include <functional>
 
 #include <dynid/input/ids.hpp>
 
@@ -27,7 +29,58 @@ dds::Reply reply_to(const dds::Request& request, dds::ReplyStatus status, std::s
   return {request.client, request.correlation_id, status, std::move(error), "text/plain", {}};
 }
 
+// The requests that compute over a whole stored run (seconds to minutes on a long one): their
+// start and end are logged with the time taken, so that an operator sees what a worker is doing.
+bool computes(const std::string& kind) {
+  for (const char* k :
+       {"residual", "add-effect", "trace", "consistency", "iv", "simex", "reprocess"})
+    if (kind == k) return true;
+  return false;
+}
+
+dds::Reply timed(const dds::Request& request, const std::function<dds::Reply()>& work) {
+  if (!computes(request.kind)) return work();
+  const auto start = std::chrono::steady_clock::now();
+  spdlog::info("request {}#{}: {} started", input::printable(request.client),
+               request.correlation_id, request.kind);
+  dds::Reply reply = work();
+  spdlog::info("request {}#{}: {} finished in {:.1f} s", input::printable(request.client),
+               request.correlation_id, request.kind,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return reply;
+}
+
 }  // namespace
+
+std::shared_ptr<Cancellation> InFlight::begin(const ReplyCache::Key& key,
+                                              dds_instance_handle_t writer) {
+  auto cancellation = std::make_shared<Cancellation>();
+  std::lock_guard lock(mutex_);
+  if (stopping_) cancellation->cancel("the server is stopping");
+  running_.insert_or_assign(key, Entry{cancellation, writer});
+  return cancellation;
+}
+
+void InFlight::end(const ReplyCache::Key& key) {
+  std::lock_guard lock(mutex_);
+  running_.erase(key);
+}
+
+void InFlight::cancel_gone(const std::function<bool(dds_instance_handle_t)>& present) {
+  std::lock_guard lock(mutex_);
+  for (auto& [key, entry] : running_)
+    if (entry.writer != 0 && !entry.cancellation->cancelled() && !present(entry.writer)) {
+      spdlog::info("request {}#{}: its client has gone; cancelled", input::printable(key.first),
+                   key.second);
+      entry.cancellation->cancel("the client that asked has gone");
+    }
+}
+
+void InFlight::stop() {
+  std::lock_guard lock(mutex_);
+  stopping_ = true;
+  for (auto& [key, entry] : running_) entry.cancellation->cancel("the server is stopping");
+}
 
 bool Server::Impl::serves(const std::string& vehicle) {
   if (!leases) return options.shard.owns(vehicle);
@@ -66,6 +119,7 @@ void Server::Impl::dispatch_round() {
   dispatch_announcements();  // first: a run's announcement before its chunks
   dispatch_chunks();
   dispatch_requests();
+  in_flight.cancel_gone([this](dds_instance_handle_t writer) { return requests.matches(writer); });
 }
 
 void Server::Impl::dispatch_announcements() {
@@ -126,7 +180,7 @@ void Server::Impl::dispatch_requests() {
   for (auto& sample : requests.take(kTakePerRound)) {
     counters.add(&CounterSnapshot::requests);
     try {
-      accept_request(dds::from_wire(sample.data));
+      accept_request(dds::from_wire(sample.data), sample.publication_handle);
     } catch (const InputError& e) {
       counters.add(&CounterSnapshot::requests_rejected);
       spdlog::warn("request rejected: {}", e.what());
@@ -151,7 +205,7 @@ bool Server::Impl::concerns_this_shard(const ParsedRequest& parsed) {
 }
 
 // Parses, routes to a shard and a worker, executes there and replies.
-void Server::Impl::accept_request(const dds::Request& request) {
+void Server::Impl::accept_request(const dds::Request& request, dds_instance_handle_t writer) {
   ParsedRequest parsed;
   try {
     parsed = parse_request(request);
@@ -170,8 +224,16 @@ void Server::Impl::accept_request(const dds::Request& request) {
   }
   if (parsed.kind == "fleet") return dispatch_fleet(parsed, request, key);
   const std::size_t worker = vehicle ? pool.worker_of(*vehicle) : 0;
-  pool.post(worker, [this, worker, parsed, request, key] {
-    answer(request, key, [&] { return execute(parsed, *services[worker]); });
+  // Registered before it is queued: a client that leaves while its request waits is seen too.
+  std::shared_ptr<const Cancellation> cancellation = in_flight.begin(key, writer);
+  // A close is never cancelled: it changes the run, and must end as it began.
+  pool.post(worker, [this, worker, parsed, request, key, cancellation] {
+    const CancellationScope scope(parsed.kind == "close" ? nullptr : cancellation);
+    answer(request, key, [&] {
+      cancellation_point();  // not started for a client that has gone
+      return timed(request, [&] { return execute(parsed, *services[worker]); });
+    });
+    in_flight.end(key);
   });
 }
 
@@ -180,6 +242,11 @@ void Server::Impl::answer(const dds::Request& request, const ReplyCache::Key& ke
   dds::Reply reply;
   try {
     reply = work();
+  } catch (const Cancelled& e) {  // nobody waits for it: the reply is for the log and the cache
+    counters.add(&CounterSnapshot::requests_cancelled);
+    spdlog::info("request {}#{} {}: {}", input::printable(request.client), request.correlation_id,
+                 request.kind, e.what());
+    reply = reply_to(request, dds::ReplyStatus::kFailed, e.what());
   } catch (const NotFound& e) {
     counters.add(&CounterSnapshot::requests_rejected);
     reply = reply_to(request, dds::ReplyStatus::kNotFound, e.what());

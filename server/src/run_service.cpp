@@ -486,10 +486,12 @@ void RunService::start_residual_job() {
       replay_stored(*it, *run, [&](const ingest::Chunk& chunk) { chunks.push_back(chunk); });
       residual_job_.emplace(ResidualJob{
           *it, run->contiguous,
-          std::async(std::launch::async,
-                     [announcement = run->processor.announcement(), chunks = std::move(chunks), models = std::move(models)] {
-                       return live_verdicts(announcement, chunks, models);
-                     })});
+          std::async(std::launch::async, [announcement = run->processor.announcement(),
+                                          chunks = std::move(chunks), models = std::move(models),
+                                          stopping = context_.stopping] {
+            const CancellationScope scope(stopping);  // a stop does not wait for the verdict
+            return live_verdicts(announcement, chunks, models);
+          })});
     } catch (const std::exception& e) {
       // A stored chunk that cannot be read back, or no thread to be had: no verdict, and the
       // worker's tick (or the publication that called it) goes on; tried again when the run is

@@ -207,6 +207,7 @@ void RunService::replay_stored(const store::RunKey& key, const RunState& state,
   // A few chunks at a time: a long run is never held whole in the store's read buffers.
   for (std::uint64_t next = 0; state.contiguous >= 0 &&
                                next <= static_cast<std::uint64_t>(state.contiguous);) {
+    cancellation_point();  // a long run read for a request nobody waits for any more
     const auto to = std::min<std::uint64_t>(next + 15, static_cast<std::uint64_t>(state.contiguous));
     for (const auto& chunk : read_chunks(key, next, to)) sink(chunk);
     next = to + 1;

@@ -165,6 +165,8 @@ void Server::run() {
 
 void Server::stop() {
   impl_->stopping.store(true);
+  impl_->in_flight.stop();  // the requests being computed end at their next cancellation point
+  impl_->stopping_work->cancel("the server is stopping");
   dds_set_guardcondition(impl_->stop_guard.get(), true);
 }
 

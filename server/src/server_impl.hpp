@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "dynid.h"
+#include "dynid/cancellation.hpp"
 #include "dynid/dds/reader.hpp"
 #include "dynid/dds/request.hpp"
 #include "dynid/server/lease_keeper.hpp"
@@ -33,6 +34,30 @@ class ReplyCache {
   std::deque<Key> order_;
 };
 
+/// The requests being executed, each with the Cancellation its computation checks
+/// (dynid/cancellation.hpp): cancelled when the server stops, and when the client that sent it
+/// has gone (its request writer no longer matched: it exited, or its lease expired), so that
+/// nobody's abandoned trace holds a worker.
+class InFlight {
+ public:
+  /// Registers `key`, sent by `writer`; once stop() was called, the cancellation comes cancelled.
+  std::shared_ptr<Cancellation> begin(const ReplyCache::Key& key, dds_instance_handle_t writer);
+  void end(const ReplyCache::Key& key);
+  /// Cancels the requests whose writer `present` no longer finds.
+  void cancel_gone(const std::function<bool(dds_instance_handle_t)>& present);
+  /// Cancels every request, now and later.
+  void stop();
+
+ private:
+  struct Entry {
+    std::shared_ptr<Cancellation> cancellation;
+    dds_instance_handle_t writer = 0;
+  };
+  std::mutex mutex_;
+  std::map<ReplyCache::Key, Entry> running_;
+  bool stopping_ = false;
+};
+
 struct Server::Impl {
   explicit Impl(ServerOptions options);
   ~Impl();
@@ -55,7 +80,8 @@ struct Server::Impl {
   void dispatch_chunk(const dynid_wire_Chunk& sample);
   /// Whether this server answers `parsed` (the routing of requests between shards).
   bool concerns_this_shard(const ParsedRequest& parsed);
-  void accept_request(const dds::Request& request);
+  /// `writer`: the request's publication handle, watched while the request runs (InFlight).
+  void accept_request(const dds::Request& request, dds_instance_handle_t writer);
   dds::Reply execute(const ParsedRequest& request, RunService& service);
   /// Runs `work` and replies with its result, or with the status its exception maps to
   /// (NotFound, InputError, anything else: FAILED); the reply is cached and sent.
@@ -76,7 +102,11 @@ struct Server::Impl {
   dds::Participant participant;
   RevisionClock revisions;
   Committer committer{store};  // before the services: stopped after the workers are done
-  ServerContext context{options, store, committer, counters, participant, revisions};
+  // Cancelled by stop(): what the workers and the live residual jobs compute ends at its next
+  // cancellation point, so that a stop does not wait for a trace.
+  std::shared_ptr<Cancellation> stopping_work = std::make_shared<Cancellation>();
+  InFlight in_flight;
+  ServerContext context{options, store, committer, counters, participant, revisions, stopping_work};
   dds::Reader<dynid_wire_RunAnnouncement> announcements;
   dds::Reader<dynid_wire_Chunk> chunks;
   dds::Reader<dynid_wire_Request> requests;

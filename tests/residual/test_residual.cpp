@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <random>
 
+#include "dynid/cancellation.hpp"
 #include "dynid/error.hpp"
 #include "dynid/ingest/recorded_run.hpp"
 #include "dynid/ls/accumulator.hpp"
@@ -161,6 +163,35 @@ TEST(EffectScreen, NamesWhyACandidateCannotBeTested) {
   FitOptions wrong_weights;
   wrong_weights.group_weights = {1.0, 2.0};  // the model has one group
   EXPECT_THROW(fit_model(*kin, {}, run, kRate, 1, wrong_weights), InputError);
+}
+
+// dynid/cancellation.hpp: the loop's fits stop at their cancellation point once the installed
+// Cancellation is cancelled, with its reason; without one, or after the scope, they run.
+TEST(Cancellation, StopsTheLoopsFitsWithTheReasonOnlyWhileInstalled) {
+  const auto kin = model::make_model("kinematic_longitudinal", {});
+  const auto run = hilly_run(0.05);
+  auto cancellation = std::make_shared<Cancellation>();
+  EXPECT_FALSE(cancellation->cancelled());
+  EXPECT_NO_THROW(cancellation_point());  // nothing installed
+  {
+    const CancellationScope scope(cancellation);
+    EXPECT_NO_THROW(fit_model(*kin, {}, run, kRate, 5));  // installed, not cancelled
+    cancellation->cancel("the client that asked has gone");
+    cancellation->cancel("a second reason is not kept");
+    EXPECT_EQ(cancellation->reason(), "the client that asked has gone");
+    try {
+      fit_model(*kin, {}, run, kRate, 5);
+      ADD_FAILURE() << "a cancelled fit ran to its end";
+    } catch (const Cancelled& e) {
+      EXPECT_STREQ(e.what(), "cancelled: the client that asked has gone");
+    }
+    {
+      const CancellationScope inner(nullptr);  // an inner scope without one: not cancelled
+      EXPECT_NO_THROW(cancellation_point());
+    }
+    EXPECT_THROW(cancellation_point(), Cancelled);  // the outer one is back
+  }
+  EXPECT_NO_THROW(fit_model(*kin, {}, run, kRate, 5));  // the scope has ended
 }
 
 TEST(RecordedRun, RejectsMissingOrDisorderedChunksNamingThem) {

@@ -327,6 +327,7 @@ int main(int argc, char** argv) {
                  "deploy/cyclonedds/loopback.xml\n";
     return 2;
   }
+  dynid::cli::stop_on_signals();  // Ctrl-C: exit through the destructors (request_client.hpp)
   try {
     if (*vehicles_cmd) return request(c, "vehicles", {});
     if (*runs_cmd) return request(c, "runs", args({{"vehicle", vehicle}}));
@@ -382,6 +383,9 @@ int main(int argc, char** argv) {
   } catch (const dynid::cli::NoServer& e) {
     std::cerr << "dynid: " << e.what() << "\n";
     return 5;
+  } catch (const dynid::cli::Interrupted& e) {  // the participant is deleted on the way out
+    std::cerr << "dynid: " << e.what() << "\n";
+    return 130;
   } catch (const dynid::cli::ShardMismatch& e) {
     std::cerr << "dynid: " << e.what() << "\n";
     return 4;

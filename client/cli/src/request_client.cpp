@@ -2,11 +2,33 @@
 
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdlib>
 
 #include "dynid/dds/conversions.hpp"
 
 namespace dynid::cli {
+namespace {
+
+volatile std::sig_atomic_t stop_signal = 0;
+
+extern "C" void on_stop_signal(int signal) {
+  stop_signal = signal;
+}
+
+void throw_if_interrupted() {
+  if (stop_signal != 0) throw Interrupted("interrupted by signal " + std::to_string(stop_signal));
+}
+
+}  // namespace
+
+void stop_on_signals() {
+  struct sigaction action = {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
 
 std::string default_client_id() {
   char host[256] = {};
@@ -38,11 +60,12 @@ bool RequestClient::exchange(const std::string& kind, const std::vector<dds::Req
     const auto resend_at = std::min(deadline, clock::now() + resend);
     while (clock::now() < resend_at) {
       const auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(resend_at - clock::now());
-      for (auto& received : replies_.wait_take(wait)) {
+      for (auto& received : replies_.wait_take(std::min(wait, std::chrono::milliseconds(250)))) {
         const dds::Reply reply = dds::from_wire(received.data);
         if (reply.client == client_id_ && reply.correlation_id == request.correlation_id && take(reply))
           return true;
       }
+      throw_if_interrupted();
     }
   }
   return false;
@@ -61,11 +84,17 @@ dds::Reply RequestClient::call(const std::string& kind,
   std::string vehicle;
   for (const auto& a : arguments)
     if (a.name == "vehicle") vehicle = a.value;
-  throw NoServer(vehicle.empty()
-                     ? "dynid-server did not answer '" + kind + "' within " + std::to_string(timeout.count()) + " ms"
-                     : "no dynid-server answered '" + kind + "' for vehicle " + vehicle + " within " +
-                           std::to_string(timeout.count()) +
-                           " ms (only the server of the vehicle's shard answers: is it running?)");
+  throw NoServer(
+      vehicle.empty()
+          ? "dynid-server did not answer '" + kind + "' within " + std::to_string(timeout.count()) +
+                " ms"
+          : "no dynid-server answered '" + kind + "' for vehicle " + vehicle + " within " +
+                std::to_string(timeout.count()) +
+                " ms. A server is running on this DDS domain (its request reader is matched), so "
+                "the "
+                "vehicle's server is still computing (raise --timeout; it stops computing this "
+                "request once this program exits) or the server of the vehicle's shard is not "
+                "running (dynid status lists the servers)");
 }
 
 ShardReplies RequestClient::call_all(const std::string& kind,

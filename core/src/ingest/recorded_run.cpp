@@ -4,6 +4,7 @@
 #include <string>
 
 #include "derived_channels.hpp"
+#include "dynid/cancellation.hpp"
 #include "dynid/error.hpp"
 #include "dynid/signal/butterworth.hpp"
 #include "dynid/signal/derivative.hpp"
@@ -93,6 +94,7 @@ std::vector<PreprocessedSegment> preprocess_offline(const RecordedRun& run) {
     Eigen::Index e = s;
     while (e < n && run.valid[static_cast<std::size_t>(e)] != 0) ++e;
     if (e - s > padlen) {
+      cancellation_point();
       out.push_back(preprocess_segment(run, sos, s, e - s));
       out.back().edge = edge;
     }

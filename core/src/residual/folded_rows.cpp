@@ -7,6 +7,7 @@
 
 #include <Eigen/QR>
 
+#include "dynid/cancellation.hpp"
 #include "dynid/error.hpp"
 #include "dynid/model/parameter_status.hpp"
 #include "dynid/residual/road_profile.hpp"
@@ -107,6 +108,7 @@ bool listed(const std::vector<Eigen::Index>& sorted, Eigen::Index sample) {
 
 RowSelection kept_rows(const model::Model& model, const std::vector<std::string>& effects,
                        const std::vector<ingest::PreprocessedSegment>& input, double sample_rate_hz, int odmf) {
+  cancellation_point();  // each fit of the residual loop passes here
   const std::vector<std::string> model_effects = without_profiles(effects);
   const std::vector<ingest::PreprocessedSegment> run = signals_corrected(input, effects, sample_rate_hz);
   RowSelection out(run.size(), std::vector<std::vector<Eigen::Index>>(model.groups().size()));
@@ -158,6 +160,7 @@ std::vector<std::vector<Eigen::VectorXd>> centred_series(const std::vector<Varyi
 FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& effects,
                      const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
                      int odmf, const FitOptions& options, bool collect, const RowSelection* only) {
+  cancellation_point();  // each fit of the residual loop passes here
   options.cross_validation.validate();
   if (odmf < 1) throw InputError("residual analysis: odmf " + std::to_string(odmf) + " < 1");
   std::vector<std::string> model_effects;

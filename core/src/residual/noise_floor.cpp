@@ -10,6 +10,7 @@
 #include <Eigen/QR>
 #include <boost/math/distributions/normal.hpp>
 
+#include "dynid/cancellation.hpp"
 #include "dynid/error.hpp"
 #include "folded_rows.hpp"
 
@@ -414,6 +415,7 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
     std::vector<LagSums> sums(r0.size());
     std::vector<std::vector<LagSums>> blocks(kBlockRows.size(), std::vector<LagSums>(r0.size()));
     for (int d = 0; d < options.draws; ++d) {
+      cancellation_point();
       const auto noisy = ingest::preprocess_channel_again(with_noise(run, column, c.sigma, rng), segments, column);
       // Refitted: the draw's own least squares, so that the attenuation its noise causes in the
       // parameters of a noisy regressor (errors in variables, slow like the signals) is in the

@@ -9,6 +9,7 @@
 
 #include <Eigen/QR>
 
+#include "dynid/cancellation.hpp"
 #include "dynid/error.hpp"
 #include "folded_rows.hpp"
 #include "hac_wald.hpp"
@@ -201,6 +202,7 @@ Eigen::MatrixXd simulate(const model::Model& model, const std::vector<std::strin
   fit.lambda_value = Eigen::MatrixXd::Zero(width, m);
   Eigen::MatrixXd extrapolated(width, options.draws);
   for (int b = 0; b < options.draws; ++b) {
+    cancellation_point();
     const Eigen::MatrixXd z = standard_noise(run.samples.rows(), noisy.size(), rng);
     Eigen::VectorXd e = c(0) * base.value;
     for (Eigen::Index i = 0; i < m; ++i) {

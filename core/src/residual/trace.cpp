@@ -5,6 +5,7 @@
 
 #include <boost/math/distributions/normal.hpp>
 
+#include "dynid/cancellation.hpp"
 #include "dynid/error.hpp"
 
 namespace dynid::residual {
@@ -82,6 +83,7 @@ Trace trace(const model::Model& model, const std::vector<std::string>& declared,
   t.declared = declared;
   std::vector<std::string> effects = declared;
   for (int round = 0;; ++round) {
+    cancellation_point();
     TraceRound r{effects, diagnose(model, effects, run, segments, options.diagnosis), std::nullopt};
     const Verdict verdict = r.diagnosis.verdict;
     // A partial explanation is added like a full one: what it leaves may be a second effect.

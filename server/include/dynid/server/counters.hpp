@@ -25,6 +25,7 @@ struct CounterSnapshot {
   std::uint64_t requests_rejected = 0;       ///< bad request or not found
   std::uint64_t not_owned = 0;               ///< samples of vehicles of other shards (or leased elsewhere), ignored
   std::uint64_t store_errors = 0;            ///< storage failures (nothing acknowledged)
+  std::uint64_t requests_cancelled = 0;  ///< stopped computing: the client left, the server stops
 
   std::string to_json() const;
 };
@@ -36,7 +37,7 @@ class ServerCounters {
   CounterSnapshot snapshot() const;
 
  private:
-  static constexpr int kFields = 13;
+  static constexpr int kFields = 14;
   static int slot(Field field);
   std::atomic<std::uint64_t> values_[kFields] = {};
 };

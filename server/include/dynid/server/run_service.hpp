@@ -60,6 +60,7 @@
 #include <variant>
 #include <vector>
 
+#include "dynid/cancellation.hpp"
 #include "dynid/dds/chunk_receipt.hpp"
 #include "dynid/dds/participant.hpp"
 #include "dynid/ingest/run_processor.hpp"
@@ -89,6 +90,8 @@ struct ServerContext {
   ServerCounters& counters;
   const dds::Participant& participant;
   RevisionClock& revisions;
+  /// Cancelled when the server stops: the live residual job's computation checks it.
+  std::shared_ptr<const Cancellation> stopping;
 };
 
 /// A vehicle's part of a fleet request: its model's groups merged over the runs used.

@@ -31,7 +31,7 @@ struct Counter {
 };
 
 /// The server's status counters, in the order of the status reply's JSON.
-inline constexpr std::array<Counter, 13> kServerCounters{{
+inline constexpr std::array<Counter, 14> kServerCounters{{
     {"announcements", "run announcements accepted"},
     {"rejected_announcements", "run announcements rejected"},
     {"chunks_stored", "chunks stored durably (acknowledged)"},
@@ -45,6 +45,7 @@ inline constexpr std::array<Counter, 13> kServerCounters{{
     {"requests_rejected", "engineer requests refused"},
     {"not_owned", "samples of vehicles served elsewhere"},
     {"store_errors", "store errors"},
+    {"requests_cancelled", "engineer requests cancelled (client gone, server stopping)"},
 }};
 
 /// One kind of engineer request (the Request topic's `kind`) and the arguments it takes. Every

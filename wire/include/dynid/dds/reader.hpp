@@ -67,8 +67,10 @@ class Reader {
     std::vector<Sample<T>> taken;
     for (dds_return_t k = 0; k < n; ++k) {
       const auto index = static_cast<std::size_t>(k);
-      if (infos[index].valid_data && from_own_partition(samples[index].data, infos[index]))
-        taken.push_back(std::move(samples[index]));
+      if (!infos[index].valid_data || !from_own_partition(samples[index].data, infos[index]))
+        continue;
+      samples[index].publication_handle = infos[index].publication_handle;
+      taken.push_back(std::move(samples[index]));
     }
     return taken;
   }
@@ -86,6 +88,16 @@ class Reader {
 
   bool wait_for_writers(int count, std::chrono::milliseconds timeout) {
     return detail::wait_for_match(reader_.get(), false, count, timeout);
+  }
+
+  /// Whether the writer `publication` (Sample::publication_handle) is still matched: false once
+  /// it was deleted or its participant's lease expired.
+  bool matches(dds_instance_handle_t publication) const {
+    dds_builtintopic_endpoint_t* endpoint =
+        dds_get_matched_publication_data(reader_.get(), publication);
+    if (endpoint == nullptr) return false;
+    dds_builtintopic_free_endpoint(endpoint);
+    return true;
   }
 
   dds_entity_t handle() const { return reader_.get(); }

@@ -22,13 +22,14 @@ class Sample {
   Sample() { std::memset(&data, 0, sizeof data); }
   Sample(const Sample&) = delete;
   Sample& operator=(const Sample&) = delete;
-  Sample(Sample&& other) noexcept {
+  Sample(Sample&& other) noexcept : publication_handle(other.publication_handle) {
     std::memcpy(&data, &other.data, sizeof data);
     std::memset(&other.data, 0, sizeof data);
   }
   Sample& operator=(Sample&& other) noexcept {
     if (this != &other) {
       release();
+      publication_handle = other.publication_handle;
       std::memcpy(&data, &other.data, sizeof data);
       std::memset(&other.data, 0, sizeof data);
     }
@@ -37,6 +38,9 @@ class Sample {
   ~Sample() { release(); }
 
   T data;
+  /// The writer that sent it (dds_sample_info_t::publication_handle), 0 when not taken from a
+  /// reader: a server asks its reader whether that writer is still there (Reader::matches).
+  dds_instance_handle_t publication_handle = 0;
 
  private:
   void release() {

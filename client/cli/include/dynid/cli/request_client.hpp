@@ -15,6 +15,10 @@
 //   first reply.
 // - Every wait is bounded by `timeout`: NoServer is thrown, with a message saying what was
 //   waited for and what to check, when no server matched or none answered in time.
+// - After stop_on_signals(), SIGINT and SIGTERM end a wait within a second with Interrupted,
+//   so that the program exits through its destructors: the participant is deleted and the
+//   server sees at once that the client has gone (it stops computing the request) instead of
+//   after the participant's lease.
 // - The Participant must outlive the client.
 #include <chrono>
 #include <cstdint>
@@ -36,6 +40,14 @@ class NoServer : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+class Interrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Installs the SIGINT and SIGTERM handlers that make waits throw Interrupted.
+void stop_on_signals();
 
 /// "<user>@<host>/<pid>", cut to the wire's id length.
 std::string default_client_id();
