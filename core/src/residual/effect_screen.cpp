@@ -409,19 +409,16 @@ LocatedDelay delay_interval(const DelayProfile& p, double inflation) {
 }
 
 // Why a located delay is no answer, or "": its interval reaches the edge of the search (the
-// best delay may lie beyond it, or the cost has no minimum: not a delay), or it holds zero (the
-// signal is not shown to be late or early at all).
+// best delay may lie beyond it, or the cost has no minimum: not a delay). An interval holding 0
+// is still offered: the trace then refuses it for its held-out gain, and without a materiality
+// rule that refusal is what stops a clean trace from adding immaterial terms one after another.
 std::string not_located(const LocatedDelay& d, Eigen::Index max, double rate) {
   const auto ms = [&](Eigen::Index samples) {
     return std::to_string(std::llround(1000.0 * samples / rate));
   };
-  const std::string interval =
-      "its 95 % interval of delays (" + ms(d.earliest) + " to " + ms(d.latest) + " ms)";
-  if (d.earliest <= -max || d.latest >= max)
-    return interval + " reaches the edge of the search (+-" + ms(max) + " ms): no delay located";
-  if (d.earliest <= 0 && d.latest >= 0)
-    return interval + " holds 0: the signal is not shown to be late or early";
-  return "";
+  if (d.earliest > -max && d.latest < max) return "";
+  return "its 95 % interval of delays (" + ms(d.earliest) + " to " + ms(d.latest) +
+         " ms) reaches the edge of the search (+-" + ms(max) + " ms): no delay located";
 }
 
 std::string seconds_text(double t) {
