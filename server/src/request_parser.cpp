@@ -116,4 +116,11 @@ int parse_rounds(const std::optional<std::string>& text) {
   return static_cast<int>(*rounds);
 }
 
+bool parse_series(const std::optional<std::string>& text) {
+  if (!text) return false;
+  if (*text != "yes")
+    throw InputError("series '" + *text + "': only 'yes' (the key's presence asks for it)");
+  return true;
+}
+
 }  // namespace dynid::server

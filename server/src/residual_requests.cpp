@@ -133,36 +133,41 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
     throw InputError("trace: rounds " + std::to_string(request.rounds) + " (0 to 10)");
   if ((request.kind == "consistency" || request.kind == "iv" || request.kind == "simex") && request.format == "html")
     throw InputError(request.kind + " report: format 'html' (text or json)");
+  // The models a reference may name: the request's, or for consistency every announced one that
+  // can be made (consistency_reply names those it leaves out).
+  const bool consistency = request.kind == "consistency";
+  const ingest::ModelSpec* spec =
+      consistency ? nullptr : &announced_model(announcement, request.model);
   std::vector<std::unique_ptr<model::Model>> models;
-  for (const ingest::ModelSpec& spec : announcement.models)
-    if (request.kind == "consistency" || spec.model == request.model) try {
-        models.push_back(model::make_model(spec.model, spec.constants));
-      } catch (const InputError&) {
-        if (request.kind != "consistency") throw;  // consistency names the models it leaves out
-      }
-  if (request.kind != "consistency" && models.empty())
-    announced_model(announcement, request.model);  // names the models
+  if (spec != nullptr) models.push_back(model::make_model(spec->model, spec->constants));
+  for (std::size_t k = 0; consistency && k < announcement.models.size(); ++k) {
+    try {
+      models.push_back(
+          model::make_model(announcement.models[k].model, announcement.models[k].constants));
+    } catch (const InputError&) {  // left out, and named, by consistency_reply
+    }
+  }
   check_reference_names(request.reference, models);
   const ingest::RecordedRun run = ingest::assemble_run(announcement, chunks);
   const auto segments = ingest::preprocess_offline(run);
   if (segments.empty())
     throw InputError("run " + announcement.vehicle + "/" + announcement.run + ": no valid segment long enough to filter");
-  if (request.kind == "consistency") return consistency_reply(announcement, segments, request);
-  const ingest::ModelSpec& spec = announced_model(announcement, request.model);
-  const std::vector<std::string> declared = request.effects.value_or(spec.effects);
-  const auto model = model::make_model(spec.model, spec.constants);
+  if (consistency) return consistency_reply(announcement, segments, request);
+  const std::vector<std::string> declared = request.effects.value_or(spec->effects);
+  const model::Model& model = *models.front();
   const double rate = announcement.sample_rate_hz;
   const int odmf = announcement.preprocessing.odmf;
-  const std::string title = announcement.vehicle + " / " + announcement.run + " / " + spec.model;
+  const std::string title = announcement.vehicle + " / " + announcement.run + " / " + spec->model;
   if (request.kind == "iv") {
-    const residual::IvFit fit = iv_of(*model, declared, announcement, segments);
+    const residual::IvFit fit = iv_of(model, declared, announcement, segments);
     if (request.format == "json") return {report::iv_json(fit), "application/json"};
     return {report::format_iv_text(fit), "text/plain"};
   }
   if (request.kind == "simex") {  // the live judgement's fit (same noise, same draws), on demand
-    const residual::SimexFit fit = simex_of(*model, declared, run, segments, run_noise(run, segments));
+    const residual::SimexFit fit =
+        simex_of(model, declared, run, segments, run_noise(run, segments));
     const std::vector<bool> by_simex =
-        simex_rows_where_least_squares_stands(*model, declared, fit, segments, rate, odmf);
+        simex_rows_where_least_squares_stands(model, declared, fit, segments, rate, odmf);
     if (request.format == "json") return {report::simex_json(fit, by_simex), "application/json"};
     return {report::format_simex_text(fit, by_simex), "text/plain"};
   }
@@ -171,17 +176,18 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
     options.max_rounds = request.rounds;
     options.reference = request.reference;
     options.diagnosis.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
-    return trace_reply(residual::trace(*model, declared, run, options), title, request.format,
+    return trace_reply(residual::trace(model, declared, run, options), title, request.format,
                        request.series);
   }
   if (request.effect.empty()) {
     residual::DiagnosisOptions options;
     options.screen.only = request.candidates;
     options.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
-    return diagnosis_reply(residual::diagnose(*model, declared, run, segments, options), title, request.format);
+    return diagnosis_reply(residual::diagnose(model, declared, run, segments, options), title,
+                           request.format);
   }
-  const residual::EffectComparison cmp =
-      residual::compare_effect(*model, declared, request.effect, segments, rate, odmf, {}, request.reference);
+  const residual::EffectComparison cmp = residual::compare_effect(
+      model, declared, request.effect, segments, rate, odmf, {}, request.reference);
   if (request.format == "json")
     return {report::comparison_json(cmp, request.series), "application/json"};
   if (request.format == "html") return {report::residual_html({title, nullptr, &cmp}), "text/html"};

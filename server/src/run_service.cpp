@@ -462,6 +462,9 @@ void RunService::refresh_residual(const store::RunKey& key, const RunState& run)
 
 void RunService::start_residual_job() {
   if (residual_job_) return;
+  // Called from a tick or from a request's publication: the live job is the server's, not that
+  // request's, so only the server's stop cancels reading its run back.
+  const CancellationScope stop_only(context_.stopping);
   const auto now = std::chrono::steady_clock::now();
   for (auto it = residual_stale_.begin(); it != residual_stale_.end();) {
     RunState* run = find(*it);

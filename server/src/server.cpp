@@ -229,11 +229,7 @@ dds::Reply Server::Impl::execute(const ParsedRequest& r, RunService& service) {
     ResidualRequest request{r.kind == "consistency" ? "" : r.required("model"), std::nullopt, split_list(r.optional("candidates").value_or("")),
                             r.kind == "add-effect" ? r.required("effect") : "", r.optional("format").value_or("text"),
                             r.kind, parse_references(r.all("reference")), parse_rounds(r.optional("rounds"))};
-    if (const auto series = r.optional("series")) {
-      if (*series != "yes")
-        throw InputError("series '" + *series + "': only 'yes' (the key's presence asks for it)");
-      request.series = true;
-    }
+    request.series = parse_series(r.optional("series"));
     if (const auto effects = r.optional("effects"))  // "none": the model with no effect declared
       request.effects = *effects == "none" ? std::vector<std::string>{} : split_list(*effects);
     ResidualReply reply = service.residual(vehicle, r.required("run"), request);

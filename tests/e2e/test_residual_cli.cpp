@@ -115,6 +115,12 @@ TEST(E2eResidualCli, DiagnosesAndTracesInTextAndJson) {
     EXPECT_FALSE(t["rounds"][k]["added"].contains("effect_series")) << "round " << k;
     EXPECT_TRUE(ts["rounds"][k]["added"].contains("effect_series")) << "round " << k;
   }
+  const auto bad_series = request("trace", {{"vehicle", "trace-car"},
+                                            {"run", "run-t"},
+                                            {"model", "kinematic_longitudinal"},
+                                            {"series", "no"}});
+  EXPECT_EQ(bad_series.status, dds::ReplyStatus::kBadRequest);
+  EXPECT_NE(bad_series.error.find("series 'no'"), std::string::npos) << bad_series.error;
 
   args = {"trace"};
   args.insert(args.end(), where.begin(), where.end());

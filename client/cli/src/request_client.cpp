@@ -90,11 +90,10 @@ dds::Reply RequestClient::call(const std::string& kind,
                 " ms"
           : "no dynid-server answered '" + kind + "' for vehicle " + vehicle + " within " +
                 std::to_string(timeout.count()) +
-                " ms. A server is running on this DDS domain (its request reader is matched), so "
-                "the "
-                "vehicle's server is still computing (raise --timeout; it stops computing this "
-                "request once this program exits) or the server of the vehicle's shard is not "
-                "running (dynid status lists the servers)");
+                " ms. A server is running on this DDS domain (its request reader is matched), "
+                "so the vehicle's server is still computing (raise --timeout; it stops computing "
+                "this request once this program exits) or the server of the vehicle's shard is "
+                "not running (dynid status lists the servers)");
 }
 
 ShardReplies RequestClient::call_all(const std::string& kind,
