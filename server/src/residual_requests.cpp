@@ -33,15 +33,21 @@ const ingest::ModelSpec& announced_model(const ingest::RunAnnouncement& a, const
 
 // A reference value must name a parameter that a model of the request has, declared or through
 // one of its candidate effects: a misspelt name would otherwise be ignored and the report would
-// print no error where the engineer expects one.
+// print no error where the engineer expects one. One model's trace takes its parameters' names;
+// consistency, across models, the quantity a parameter measures where it declares one
+// (ParameterInfo::reference_key: "ax_sensor_scale", not the "sensor_scale" of two sensors).
 void check_reference_names(const std::map<std::string, double>& reference,
-                           const std::vector<std::unique_ptr<model::Model>>& models) {
+                           const std::vector<std::unique_ptr<model::Model>>& models,
+                           bool by_quantity) {
   std::set<std::string> known;
   std::string owners;
+  const auto key = [by_quantity](const model::ParameterInfo& p) {
+    return by_quantity ? p.reference_key() : p.name;
+  };
   for (const auto& m : models) {
-    for (const model::ParameterInfo& p : m->parameters()) known.insert(p.name);
+    for (const model::ParameterInfo& p : m->parameters()) known.insert(key(p));
     for (const model::Effect& e : m->candidate_effects())
-      for (const model::ParameterInfo& p : e.parameters) known.insert(p.name);
+      for (const model::ParameterInfo& p : e.parameters) known.insert(key(p));
     owners += (owners.empty() ? "" : ", ") + m->name();
   }
   std::string unknown;
@@ -52,7 +58,8 @@ void check_reference_names(const std::map<std::string, double>& reference,
   std::string names;
   for (const auto& name : known) names += (names.empty() ? "" : ", ") + name;
   throw InputError("--reference " + unknown + ": no parameter of " + owners +
-                   " or their effects has this name (" + names + ")");
+                   " or their effects has this " + (by_quantity ? "quantity or name (" : "name (") +
+                   names + ")");
 }
 
 }  // namespace
@@ -147,7 +154,7 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
     } catch (const InputError&) {  // left out, and named, by consistency_reply
     }
   }
-  check_reference_names(request.reference, models);
+  check_reference_names(request.reference, models, consistency);
   const ingest::RecordedRun run = ingest::assemble_run(announcement, chunks);
   const auto segments = ingest::preprocess_offline(run);
   if (segments.empty())

@@ -148,8 +148,15 @@ TEST(E2eResidualCli, DiagnosesAndTracesInTextAndJson) {
   EXPECT_EQ(rounds.exit_code, 2);
   EXPECT_NE(rounds.err.find("0 to 10"), std::string::npos) << rounds.err;
 
-  // Every model of the run, shared parameters and a reference value compared.
-  args = {"consistency", "--vehicle", "trace-car", "--run", "run-t", "--reference", "sensor_scale=1.0"};
+  // Across models a reference names the quantity: which accelerometer's scale, not a name two
+  // sensors share.
+  const auto by_name = dynid({"consistency", "--vehicle", "trace-car", "--run", "run-t",
+                              "--reference", "sensor_scale=1.0"});
+  EXPECT_EQ(by_name.exit_code, 2) << by_name.out;
+  EXPECT_NE(by_name.err.find("ax_sensor_scale"), std::string::npos) << by_name.err;
+  // Every model of the run, shared quantities and a reference value compared.
+  args = {"consistency", "--vehicle",   "trace-car",          "--run",
+          "run-t",       "--reference", "ax_sensor_scale=1.0"};
   const auto consistency = dynid(args);
   ASSERT_EQ(consistency.exit_code, 0) << consistency.err;
   EXPECT_NE(consistency.out.find("consistency: "), std::string::npos) << consistency.out;

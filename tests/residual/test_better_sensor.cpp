@@ -56,5 +56,25 @@ TEST(BetterSensor, WhereItDoesNotSharpenTheStdAreAddedAndTheEffectsOwnTermIsLeft
   EXPECT_NE(better_sensor_refusal(c), "");
 }
 
+// A part of the residual is no license to move the physics: a column more widens the declared
+// parameters' std, and a move beyond the widening (std_after^2 - std_before^2) is refused.
+TEST(PartialExplanation, AMoveBeyondTheWideningItAddsIsRefused) {
+  // std 1 -> sqrt(2): the difference's std is 1; at 1 % over one parameter the bound is 2.58.
+  auto c = comparison({change("yaw_inertia", 2130.0, 1.0, 2132.0, std::sqrt(2.0))});
+  c.effect = "dict:d:vy";
+  EXPECT_EQ(partial_refusal(c), "");
+  c.parameters.front().after = 2140.0;  // 10 std
+  const std::string why = partial_refusal(c);
+  EXPECT_NE(why.find("dict:d:vy refused: it explains a part of the residual only"),
+            std::string::npos)
+      << why;
+  EXPECT_NE(why.find("yaw_inertia from 2130 to 2140 u, 10 std"), std::string::npos) << why;
+  // A move of 3: 3 std of the widening, beyond 2.58; the better sensor's test, whose difference
+  // variance is the sum (3) where the std widens, reads 1.73 std and would not refuse it.
+  c.parameters.front().after = 2133.0;
+  EXPECT_NE(partial_refusal(c), "");
+  EXPECT_EQ(better_sensor_refusal(c), "");
+}
+
 }  // namespace
 }  // namespace dynid::residual

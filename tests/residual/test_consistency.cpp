@@ -17,8 +17,11 @@
 namespace dynid::residual {
 namespace {
 
+// Parameters named for the quantity they measure (ParameterInfo::quantity = name), unless
+// `quantity_prefix` makes them a sensor's own ("ax_" + name).
 ModelParameters fitted(const std::string& model, std::vector<std::string> measured_side,
-                       const std::vector<std::pair<std::string, double>>& values, double relative_std) {
+                       const std::vector<std::pair<std::string, double>>& values,
+                       double relative_std, const std::string& quantity_prefix = "") {
   ModelParameters m;
   m.model = model;
   m.measured_side = std::move(measured_side);
@@ -26,6 +29,7 @@ ModelParameters fitted(const std::string& model, std::vector<std::string> measur
   m.std.resize(m.value.size());
   for (std::size_t j = 0; j < values.size(); ++j) {
     m.parameters.push_back({values[j].first, "u", "", std::nullopt});
+    m.parameters.back().quantity = quantity_prefix + values[j].first;
     m.value(static_cast<Eigen::Index>(j)) = values[j].second;
     m.std(static_cast<Eigen::Index>(j)) = relative_std * std::abs(values[j].second);
   }
@@ -72,6 +76,59 @@ TEST(Consistency, DisagreementsByDifferentRatiosAreNotCalledAScale) {
                                           {});
   ASSERT_EQ(c.scales.size(), 1U);
   EXPECT_FALSE(c.scales.front().one_ratio) << c.scales.front().statement;
+}
+
+TEST(Consistency, ParametersThatOnlyShareANameAreNotCompared) {
+  // The ax and ay accelerometers' scales, 0.99 and 1.02 +- 0.0001: two sensors, not one.
+  const Consistency c =
+      check_consistency({fitted("kin_x", {"ax"}, {{"sensor_scale", 0.99}}, 1e-4, "ax_"),
+                         fitted("kin_y", {"ay"}, {{"sensor_scale", 1.02}}, 1e-4, "ay_")},
+                        {{"ax_sensor_scale", 0.99}});
+  EXPECT_TRUE(c.consistent()) << c.statement();
+  ASSERT_EQ(c.tests, 1);  // the reference applies to its quantity only
+  EXPECT_EQ(c.comparisons.front().first, "kin_x");
+  // A parameter without a declared quantity is the model's own: compared with nothing.
+  ModelParameters a = fitted("a", {"x"}, {{"engine_inertia", 0.16}}, 1e-3);
+  ModelParameters b = fitted("b", {"y"}, {{"engine_inertia", 0.172}}, 1e-3);
+  b.parameters.front().quantity.clear();
+  EXPECT_EQ(check_consistency({a, b}, {}).tests, 0);
+}
+
+TEST(Consistency, AParameterTheRunDoesNotExciteIsComparedWithNothing) {
+  ModelParameters wheel = fitted("wheel", {"wheel_torque"}, kTruth, 0.004);
+  ModelParameters engine = fitted("engine", {"engine_torque"}, scaled(0.6), 0.004);
+  // The engine model's mass: std 2000 kg, at least a car's typical 1500 kg: not excited.
+  engine.parameters[0].typical = 1500.0;
+  engine.std(0) = 2000.0;
+  const Consistency c = check_consistency({wheel, engine}, {});
+  EXPECT_EQ(c.tests, 2);  // SCx and rolling resistance only
+  for (const ParameterAgreement& p : c.comparisons) EXPECT_NE(p.parameter, "mass");
+}
+
+TEST(Consistency, ModelsDeclareTheQuantitiesTheyShare) {
+  const auto quantity_of = [](const std::string& name, const std::string& parameter) {
+    // The test car's constants; the engine-torque model (not in its profile) with the
+    // driveline efficiency it needs beside them.
+    const std::string profiled = name == "longitudinal_engine" ? "longitudinal_wheel" : name;
+    model::Constants constants = sim::test::model_spec(profiled, {}).constants;
+    constants["driveline_efficiency"] = 0.93;
+    const auto m = model::make_model(name, constants);
+    std::vector<model::ParameterInfo> all = m->parameters();
+    for (const model::Effect& e : m->candidate_effects())
+      all.insert(all.end(), e.parameters.begin(), e.parameters.end());
+    for (const model::ParameterInfo& p : all)
+      if (p.name == parameter) return p.quantity;
+    ADD_FAILURE() << name << " has no " << parameter;
+    return std::string{};
+  };
+  EXPECT_EQ(quantity_of("longitudinal_wheel", "mass"), quantity_of("longitudinal_engine", "mass"));
+  EXPECT_EQ(quantity_of("longitudinal_wheel", "SCx"), "SCx");
+  EXPECT_EQ(quantity_of("kinematic_longitudinal", "sensor_scale"), "ax_sensor_scale");
+  EXPECT_EQ(quantity_of("kinematic_lateral", "sensor_scale"), "ay_sensor_scale");
+  EXPECT_EQ(quantity_of("clutch_slip", "engine_inertia"), "engine_inertia");
+  EXPECT_EQ(quantity_of("longitudinal_engine", "engine_inertia"), "");  // J_e + J_in
+  EXPECT_EQ(quantity_of("clutch_slip", "engine_torque_offset"),
+            quantity_of("longitudinal_engine", "engine_torque_offset"));
 }
 
 // The product's path: the acceleration run's longitudinal model against the simulated car's

@@ -14,6 +14,7 @@
 #include "dynid/ls/accumulator.hpp"
 #include "dynid/ls/estimate.hpp"
 #include "dynid/model/registry.hpp"
+#include "dynid/residual/diagnosis.hpp"
 #include "dynid/residual/effect_comparison.hpp"
 #include "dynid/residual/effect_screen.hpp"
 #include "dynid/residual/spectrum.hpp"
@@ -167,6 +168,42 @@ TEST(EffectScreen, NamesWhyACandidateCannotBeTested) {
 
 // dynid/cancellation.hpp: the loop's fits stop at their cancellation point once the installed
 // Cancellation is cancelled, with its reason; without one, or after the scope, they run.
+// Materiality (diagnosis.hpp): a candidate matters when it takes its model to the floor or removes
+// at least the excess the floor test resolves, judged in the group where it removes most.
+TEST(Materiality, WeighsTheMeanSquareRemovedAgainstTheFloorTestsResolution) {
+  const auto group = [](const char* name, double residual_rms, double floor_rms,
+                        double upper_ratio) {
+    GroupFloor g;
+    g.group = name;
+    g.rows = 1000;
+    g.residual_rms = residual_rms;
+    g.floor_rms = floor_rms;
+    g.ratio = residual_rms * residual_rms / (floor_rms * floor_rms);
+    g.upper_ratio = upper_ratio;
+    g.at_floor = g.ratio <= upper_ratio;
+    return g;
+  };
+  NoiseFloor declared;
+  declared.groups = {group("lateral", 10.5, 10.0, 1.36),
+                     group("yaw", 12.5, 10.0, 1.25)};  // yaw 1.5625
+  NoiseFloor small = declared;
+  small.groups[1] = group("yaw", 12.3, 10.0, 1.25);  // removes 0.0494: a delay of 0 ms
+  const Materiality s = materiality(declared, small);
+  EXPECT_FALSE(s.material());
+  EXPECT_EQ(s.group, "yaw");
+  EXPECT_NEAR(s.removed, (12.5 * 12.5 - 12.3 * 12.3) / 100.0, 1e-12);
+  EXPECT_NEAR(s.resolution, 0.25, 1e-12);
+  NoiseFloor large = declared;
+  large.groups[1] =
+      group("yaw", 11.4, 10.0, 1.25);  // removes 0.2629 >= 0.25, still above its floor
+  EXPECT_TRUE(materiality(declared, large).material());
+  EXPECT_FALSE(materiality(declared, large).reaches);
+  NoiseFloor reaching = declared;
+  reaching.groups[1] = group("yaw", 11.1, 10.0, 1.25);  // removes 0.33, and reaches 1.2321 <= 1.25
+  EXPECT_TRUE(materiality(declared, reaching).reaches);
+  EXPECT_TRUE(materiality(declared, reaching).material());
+}
+
 TEST(Cancellation, StopsTheLoopsFitsWithTheReasonOnlyWhileInstalled) {
   const auto kin = model::make_model("kinematic_longitudinal", {});
   const auto run = hilly_run(0.05);

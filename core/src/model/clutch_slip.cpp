@@ -66,10 +66,13 @@ std::function<double(double)> ClutchSlipModel::clamp_load() const {
 }
 
 std::vector<ParameterInfo> ClutchSlipModel::parameters() const {
-  return {excited(positive(parameter("engine_inertia", "kg m^2", "engine and flywheel inertia J_e")),
+  return {excited(detail::measures(positive(parameter("engine_inertia", "kg m^2",
+                                                      "engine and flywheel inertia J_e")),
+                                   "engine_inertia"),
                   0.2, "d_engine_speed while the clutch slips (launches)"),
-          excited(detail::bounded(parameter("coulomb_friction", "-", "Coulomb friction coefficient mu_c"),
-                                  0.0, 2.0),
+          excited(detail::bounded(
+                      parameter("coulomb_friction", "-", "Coulomb friction coefficient mu_c"), 0.0,
+                      2.0),
                   0.3, "clutch_clamp_load while the clutch slips (launches)")};
 }
 
@@ -103,12 +106,13 @@ std::vector<RowModel::EffectDefinition> ClutchSlipModel::effect_definitions() co
                        {parameter("viscous_friction", "s/rad", "mu_v")},
                        {}},
                       [](double slip) { return slip; }),
-      detail::one_column({effect::kTorqueOffset, "ECU engine torque offset (true = ECU + T0)",
-                          {parameter("engine_torque_offset", "N m", "T0", 0.0)},
-                          {}},
-                         [](const ChannelSet&) {
-                           return detail::ValueFn([](Eigen::Index) { return -1.0; });
-                         })};
+      detail::one_column(
+          {effect::kTorqueOffset,
+           "ECU engine torque offset (true = ECU + T0)",
+           {detail::measures(parameter("engine_torque_offset", "N m", "T0", 0.0),
+                             "engine_torque_offset")},
+           {}},
+          [](const ChannelSet&) { return detail::ValueFn([](Eigen::Index) { return -1.0; }); })};
   if (!stribeck_speed_) return out;
   const double vs = *stribeck_speed_;
   out.push_back(friction_effect(

@@ -32,10 +32,15 @@ std::vector<ParameterInfo> KinematicModel::parameters() const {
   // wrong way round or a sign error in the profile, not a car); the offset has either sign.
   const std::string by = axis_ == Axis::kLongitudinal ? "d_vx (accelerate, brake)"
                                                        : "d_vy + vx yaw_rate (corner)";
-  return {excited(positive(parameter("sensor_scale", "-", "accelerometer gain over speed scale", 1.0)),
+  // Each axis has its own accelerometer: its scale and offset are quantities of that sensor.
+  const std::string sensor = measured_side().front();
+  return {excited(detail::measures(positive(parameter("sensor_scale", "-",
+                                                      "accelerometer gain over speed scale", 1.0)),
+                                   sensor + "_sensor_scale"),
                   std::nullopt, by),
-          excited(parameter("sensor_offset", "m/s^2", "accelerometer offset", 0.0), std::nullopt,
-                  "time: any run")};
+          excited(detail::measures(parameter("sensor_offset", "m/s^2", "accelerometer offset", 0.0),
+                                   sensor + "_sensor_offset"),
+                  std::nullopt, "time: any run")};
 }
 
 std::vector<ChannelNeed> KinematicModel::channels() const {

@@ -47,13 +47,17 @@ std::vector<ParameterInfo> LongitudinalModel::parameters() const {
   // the same column within a gear, is left in the data).
   // Typical magnitudes of a passenger car, for judging excitation only: at constant speed
   // the drag and rolling-resistance columns are proportional (v^2 and 1).
-  return {excited(positive(parameter("mass", "kg", "vehicle mass (translating)")), 1500.0,
-                  "d_vx (accelerate, brake)"),
-          excited(detail::drag_area("aerodynamic drag area S Cx"), 0.7,
-                  "vx over a wide range (coast down from high speed)"),
-          excited(non_negative(parameter("rolling_resistance", "N",
-                                         "rolling resistance force F_r = C_rr M g")),
-                  200.0, "vx over a wide range (coast down from high speed)")};
+  // Both sources measure the same car: the quantities are shared (consistency.hpp).
+  return {
+      excited(
+          detail::measures(positive(parameter("mass", "kg", "vehicle mass (translating)")), "mass"),
+          1500.0, "d_vx (accelerate, brake)"),
+      excited(detail::measures(detail::drag_area("aerodynamic drag area S Cx"), "SCx"), 0.7,
+              "vx over a wide range (coast down from high speed)"),
+      excited(detail::measures(non_negative(parameter("rolling_resistance", "N",
+                                                      "rolling resistance force F_r = C_rr M g")),
+                               "rolling_resistance"),
+              200.0, "vx over a wide range (coast down from high speed)")};
 }
 
 std::vector<ChannelNeed> LongitudinalModel::channels() const {
@@ -121,7 +125,9 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
       detail::one_column(
           {effect::kLinearDrag,
            "resistance proportional to speed (tyre losses)",
-           {non_negative(parameter("linear_drag", "N s/m", "speed-proportional resistance"))},
+           {detail::measures(
+               non_negative(parameter("linear_drag", "N s/m", "speed-proportional resistance")),
+               "linear_drag")},
            {},
            // A head wind w adds rho SCx w v (this column) and a constant (rolling resistance's):
            // runs in opposite directions change its sign, tyre losses keep theirs (SAE J2263).
@@ -132,8 +138,10 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
   if (source_ != Source::kEngineTorque) return out;
   auto factor = [this](const ChannelSet& set) { return drive(set); };
   out.push_back(detail::one_column(
-      {effect::kTorqueOffset, "engine torque sensor offset T0: F_drive = eta G (T + T0) / r_w",
-       {parameter("engine_torque_offset", "N m", "offset of the ECU torque", 0.0)},
+      {effect::kTorqueOffset,
+       "engine torque sensor offset T0: F_drive = eta G (T + T0) / r_w",
+       {detail::measures(parameter("engine_torque_offset", "N m", "offset of the ECU torque", 0.0),
+                         "engine_torque_offset")},
        {}},
       [factor](const ChannelSet& set) -> detail::ValueFn {
         return [d = factor(set)](Eigen::Index k) { return -d(k).factor; };
@@ -142,6 +150,8 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
   out.push_back(detail::one_column(
       {effect::kRotatingInertia,
        "engine inertia through the gear: eta J_e G^2 / r_w^2 d_vx",
+       // No shared quantity: with the clutch closed the gearbox input turns with the engine, so
+       // this is J_e + J_in, not the clutch model's J_e.
        {positive(parameter("engine_inertia", "kg m^2", "rotating inertia on the engine side"))},
        {}},
       [factor, r](const ChannelSet& set) -> detail::ValueFn {

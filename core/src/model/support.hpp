@@ -60,6 +60,13 @@ inline ParameterInfo excited(ParameterInfo p, std::optional<double> typical, std
   return p;
 }
 
+/// The shared physical quantity the parameter measures (ParameterInfo::quantity):
+/// measures(positive(parameter("mass", ...)), "mass").
+inline ParameterInfo measures(ParameterInfo p, std::string quantity) {
+  p.quantity = std::move(quantity);
+  return p;
+}
+
 /// <= 0: a term that can only take away (a tyre's saturation).
 inline ParameterInfo non_positive(ParameterInfo p) {
   p.upper = 0.0;

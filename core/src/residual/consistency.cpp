@@ -8,6 +8,7 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
 
+#include "dynid/model/parameter_status.hpp"
 #include "folded_rows.hpp"
 #include "hac_wald.hpp"
 
@@ -28,18 +29,27 @@ std::string join(const std::vector<std::string>& items) {
   return out;
 }
 
-// The value and HAC std of `name` in `m`, when it is identified there.
-bool lookup(const ModelParameters& m, const std::string& name, double& value, double& std, std::string& unit) {
-  for (std::size_t j = 0; j < m.parameters.size(); ++j) {
-    if (m.parameters[j].name != name) continue;
-    const auto i = static_cast<Eigen::Index>(j);
-    if (!std::isfinite(m.value(i)) || !std::isfinite(m.std(i))) return false;
-    value = m.value(i);
-    std = m.std(i);
-    unit = m.parameters[j].unit;
-    return true;
-  }
-  return false;
+// The value and HAC std of parameter j of `m`, when the run identifies it: finite, and excited
+// (parameter_status.hpp rule 1b: a std at least the quantity's typical magnitude says the run
+// cannot tell it from zero, and its value is whatever the other columns leave).
+bool lookup(const ModelParameters& m, std::size_t j, double& value, double& std) {
+  const auto i = static_cast<Eigen::Index>(j);
+  if (j >= m.parameters.size() || !std::isfinite(m.value(i)) || !std::isfinite(m.std(i)))
+    return false;
+  if (const std::optional<double> scale = model::excitation_scale(m.parameters[j]);
+      scale && m.std(i) >= *scale)
+    return false;
+  value = m.value(i);
+  std = m.std(i);
+  return true;
+}
+
+// The index in `m` of the parameter measuring `quantity` in `unit`, or npos.
+std::size_t measuring(const ModelParameters& m, const std::string& quantity,
+                      const std::string& unit) {
+  for (std::size_t j = 0; j < m.parameters.size(); ++j)
+    if (m.parameters[j].quantity == quantity && m.parameters[j].unit == unit) return j;
+  return std::string::npos;
 }
 
 ParameterAgreement compare(const std::string& parameter, const std::string& unit, const std::string& first, double a,
@@ -55,18 +65,20 @@ std::vector<ParameterAgreement> comparisons_of(const std::vector<ModelParameters
                                                const std::map<std::string, double>& reference) {
   std::vector<ParameterAgreement> out;
   for (std::size_t i = 0; i < models.size(); ++i) {
-    for (const model::ParameterInfo& p : models[i].parameters) {
+    for (std::size_t j = 0; j < models[i].parameters.size(); ++j) {
+      const model::ParameterInfo& p = models[i].parameters[j];
       double a = 0.0, sa = 0.0;
-      std::string unit;
-      if (!lookup(models[i], p.name, a, sa, unit)) continue;
-      for (std::size_t k = i + 1; k < models.size(); ++k) {
+      if (!lookup(models[i], j, a, sa)) continue;
+      // Only parameters that declare one physical quantity are compared across models: a name
+      // alone says nothing (the ax and ay sensors' scales; the clutch model's J_e and the
+      // locked driveline's J_e + J_in).
+      for (std::size_t k = i + 1; k < models.size() && !p.quantity.empty(); ++k) {
         double b = 0.0, sb = 0.0;
-        std::string unit_b;
-        if (lookup(models[k], p.name, b, sb, unit_b) && unit_b == unit)
-          out.push_back(compare(p.name, unit, models[i].model, a, sa, models[k].model, b, sb));
+        if (lookup(models[k], measuring(models[k], p.quantity, p.unit), b, sb))
+          out.push_back(compare(p.name, p.unit, models[i].model, a, sa, models[k].model, b, sb));
       }
-      if (const auto r = reference.find(p.name); r != reference.end())
-        out.push_back(compare(p.name, unit, models[i].model, a, sa, kReference, r->second, 0.0));
+      if (const auto r = reference.find(p.reference_key()); r != reference.end())
+        out.push_back(compare(p.name, p.unit, models[i].model, a, sa, kReference, r->second, 0.0));
     }
   }
   return out;

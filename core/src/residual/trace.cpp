@@ -36,6 +36,46 @@ std::string refusal(const EffectComparison& c) {
   return {};
 }
 
+// Hausman's comparison of the declared parameters before and after `c` (trace.hpp): the one
+// that moved most in std of the difference, and the bound at 1 % over the declared parameters.
+struct LargestMove {
+  const ParameterChange* parameter = nullptr;
+  double moved = 0.0;  ///< std of the difference
+  double bound = 0.0;
+  std::size_t declared = 0;
+  bool beyond() const { return parameter != nullptr && moved > bound; }
+  std::string text() const {
+    return "it takes " + parameter->name + " from " + four_digits(parameter->before) + " to " +
+           four_digits(parameter->after) + " " + parameter->unit + ", " + four_digits(moved) +
+           " std of the difference (Hausman, at most " + four_digits(bound) + " at 1 % over " +
+           std::to_string(declared) + " parameters)";
+  }
+};
+
+// `sharpens`: the candidate is a better sensor, efficient under the hypothesis, so the difference's
+// variance is std_before^2 - std_after^2; else it is a column more, the declared fit the efficient
+// one, and the variance std_after^2 - std_before^2. Where that is not positive, the sum
+// (conservative).
+LargestMove largest_move(const EffectComparison& c, bool sharpens) {
+  LargestMove out;
+  for (const ParameterChange& p : c.parameters)
+    out.declared += std::isfinite(p.before) && std::isfinite(p.after) ? 1 : 0;
+  if (out.declared == 0) return out;
+  constexpr double kFamilyErrorRate = 0.01;
+  out.bound = boost::math::quantile(boost::math::complement(
+      boost::math::normal(), kFamilyErrorRate / (2.0 * static_cast<double>(out.declared))));
+  for (const ParameterChange& p : c.parameters) {
+    if (!std::isfinite(p.before) || !std::isfinite(p.after)) continue;
+    const double difference = p.std_before * p.std_before - p.std_after * p.std_after;
+    double variance = sharpens ? difference : -difference;
+    if (!(variance > 0.0)) variance = p.std_before * p.std_before + p.std_after * p.std_after;
+    if (!(variance > 0.0)) continue;
+    const double moved = std::abs(p.after - p.before) / std::sqrt(variance);
+    if (moved > out.moved) out.parameter = &p, out.moved = moved;
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::string> Trace::added() const {
@@ -45,31 +85,21 @@ std::vector<std::string> Trace::added() const {
   return out;
 }
 
+std::string partial_refusal(const EffectComparison& c) {
+  const LargestMove m = largest_move(c, false);
+  if (!m.beyond()) return {};
+  return c.effect + " refused: it explains a part of the residual only, and " + m.text() +
+         ": with the model still above its floor, nothing says the moved values are nearer the "
+         "car's";
+}
+
 std::string better_sensor_refusal(const EffectComparison& c) {
-  std::size_t declared = 0;
-  for (const ParameterChange& p : c.parameters) declared += std::isfinite(p.before) && std::isfinite(p.after) ? 1 : 0;
-  if (declared == 0) return {};
-  constexpr double kFamilyErrorRate = 0.01;
-  const double z = boost::math::quantile(boost::math::complement(
-      boost::math::normal(), kFamilyErrorRate / (2.0 * static_cast<double>(declared))));
-  const ParameterChange* worst = nullptr;
-  double worst_moved = 0.0;
-  for (const ParameterChange& p : c.parameters) {
-    if (!std::isfinite(p.before) || !std::isfinite(p.after)) continue;
-    // A sensor that does not sharpen a parameter: its difference's variance is taken as the sum
-    // (conservative), Hausman's difference being undefined there.
-    const double variance = p.std_before > p.std_after ? p.std_before * p.std_before - p.std_after * p.std_after
-                                                       : p.std_before * p.std_before + p.std_after * p.std_after;
-    if (!(variance > 0.0)) continue;
-    const double moved = std::abs(p.after - p.before) / std::sqrt(variance);
-    if (moved > worst_moved) worst = &p, worst_moved = moved;
-  }
-  if (worst == nullptr || !(worst_moved > z)) return {};
-  return c.effect + " refused: as a better sensor of a declared signal (at the declared floor) it should "
-                    "sharpen the parameters, not move them, but it takes " + worst->name + " from " +
-         four_digits(worst->before) + " to " + four_digits(worst->after) + " " + worst->unit + ", " +
-         four_digits(worst_moved) + " std of the difference (Hausman, at most " + four_digits(z) + " at 1 % over " +
-         std::to_string(declared) + " parameters): it differs from that signal systematically, not only in noise";
+  const LargestMove m = largest_move(c, true);
+  if (!m.beyond()) return {};
+  return c.effect +
+         " refused: as a better sensor of a declared signal (at the declared floor) it should "
+         "sharpen the parameters, not move them, but " +
+         m.text() + ": it differs from that signal systematically, not only in noise";
 }
 
 Trace trace(const model::Model& model, const std::vector<std::string>& declared,
@@ -86,7 +116,8 @@ Trace trace(const model::Model& model, const std::vector<std::string>& declared,
     cancellation_point();
     TraceRound r{effects, diagnose(model, effects, run, segments, options.diagnosis), std::nullopt};
     const Verdict verdict = r.diagnosis.verdict;
-    // A partial explanation is added like a full one: what it leaves may be a second effect.
+    // A partial explanation is added like a full one (what it leaves may be a second effect),
+    // unless it moves the declared physics (partial_refusal).
     if (!r.diagnosis.accepted) {
       t.stopped = std::string(verdict_name(verdict)) + " after " + std::to_string(round) + " added effect" +
                   (round == 1 ? "" : "s");
@@ -103,6 +134,9 @@ Trace trace(const model::Model& model, const std::vector<std::string>& declared,
                                         options.diagnosis.screen.fit, options.reference);
     std::string why = refusal(c);
     if (why.empty() && r.diagnosis.masked) why = better_sensor_refusal(c);
+    if (why.empty() && r.diagnosis.partial && !r.diagnosis.better_sensor &&
+        r.diagnosis.accepted->kind == CandidateKind::kDictionary)
+      why = partial_refusal(c);
     if (!why.empty()) {
       t.stopped = why + (r.diagnosis.implausible.empty() ? "" : "; the model as it stands is implausible on this run");
       t.rounds.push_back(std::move(r));

@@ -50,7 +50,16 @@ struct ParameterInfo {
   /// the manoeuvre that moves it: "d_vx (accelerate, brake)". Printed for a parameter the run
   /// does not excite.
   std::string excited_by = {};
+  /// The physical quantity of the car the parameter measures, named alike by every model that
+  /// measures the same one ("mass", "ax_sensor_scale", "engine_inertia" of the engine side of the
+  /// clutch); residual/consistency.hpp compares only parameters of one quantity, and a reference
+  /// value given for it applies to them alone. Empty: a coefficient of this model only (a
+  /// sensor scale of an axis no other model reads, an inertia that includes another body's).
+  std::string quantity = {};
 
+  /// The name a consistency reference value is given under: the quantity when declared, else
+  /// the parameter's name.
+  const std::string& reference_key() const { return quantity.empty() ? name : quantity; }
   /// True when `value` is within the bounds, and for NaN: a parameter that is not identifiable
   /// (NaN estimate) is not out of bounds. +-Inf is out of any bound on its side.
   bool within_bounds(double value) const;

@@ -4,14 +4,20 @@
 // reads 7 % high, or a rolling radius 3 % off, rescale every parameter of a model exactly and the
 // residual only scales. They show up as disagreement").
 //
-// Compared: every parameter that two models of the run share by name (the wheel-torque and the
-// engine-torque longitudinal models share mass, SCx, rolling resistance; the clutch and the
-// locked-driveline models share the engine inertia), and every parameter for which the engineer
-// gives a reference value (the weighed mass). The test of one comparison: z = (a - b) /
-// sqrt(sa^2 + sb^2) (a reference has no std), two-sided, at family_error_rate / m (Bonferroni over
-// the m comparisons, so that a run whose models agree raises an alarm at most that often).
-// Ignoring the correlation of two fits of one run is conservative: they share the run's noise,
-// which makes var(a - b) smaller than sa^2 + sb^2, not larger.
+// Compared: every pair of parameters of two models of the run that measure one physical quantity
+// of the car (model::ParameterInfo::quantity: the wheel-torque and the engine-torque
+// longitudinal models share mass, SCx, rolling resistance; the clutch model and the
+// engine-torque one the ECU's torque offset), never two parameters that only share a name (the
+// ax and the ay accelerometers' scales; the clutch model's engine inertia and the locked
+// driveline's, which includes the gearbox input); and every parameter for which the engineer
+// gives a reference value (the weighed mass), under its quantity's name when it declares one
+// (ParameterInfo::reference_key: "ax_sensor_scale", not every "sensor_scale"). A parameter the
+// run does not excite (its std at least its typical magnitude, model/parameter_status.hpp) is
+// compared with nothing: its value is whatever the other columns leave. The test of one comparison:
+// z = (a - b) / sqrt(sa^2 + sb^2) (a reference has no std), two-sided, at family_error_rate / m
+// (Bonferroni over the m comparisons, so that a run whose models agree raises an alarm at most that
+// often). Ignoring the correlation of two fits of one run is conservative: they share the run's
+// noise, which makes var(a - b) smaller than sa^2 + sb^2, not larger.
 //
 // The standard deviations are HAC ones (Newey-West on the rows' scores, hac_wald.hpp): the rows
 // are low-passed and decimated, and DYCARO's sigma^2 (W'W)^-1 counts every row as independent,

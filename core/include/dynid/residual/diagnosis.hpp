@@ -15,6 +15,10 @@
 // hidden-structure test below, the better sensor's model against its own floor at the same
 // level: together at most 0.05, one false alarm in 20 clean runs (the union bound). Candidates are
 // then judged by the screen (HAC Wald test at family_error_rate / m, and a held-out gain), and a
+// significant candidate must also be material: it takes its model to that model's floor, or
+// removes at least the smallest excess the floor test resolves (upper_ratio - 1 of the floor's
+// mean square, in some group); smaller structure is refused as immaterial, with its size, and
+// is never the verdict's explanation nor an added term (diagnosis.cpp, "Materiality"). A
 // significant candidate that takes the residual below the floor (its mean square under the
 // floor's lower critical ratio) is refused: a missing effect adds to the noise, so removing it
 // can bring the residual down to the floor, not under it. Only a better sensor of a declared
@@ -114,6 +118,9 @@ struct Diagnosis {
   /// its own (lower) floor: structure the declared signals' noise hides (see above). Set with
   /// `partial`.
   bool masked = false;
+  /// The accepted candidate lowers the noise floor: a better sensor of a declared signal (the
+  /// accelerometer for d_vx), not a missing effect.
+  bool better_sensor = false;
   std::vector<RefusedCandidate> refused;  ///< significant candidates refused, with the reason
   Signature signature;
   /// Physical effects this run cannot rule out although they would bias the declared
@@ -131,6 +138,21 @@ struct Diagnosis {
   /// The verdict and its evidence alone.
   std::string verdict_statement() const;
 };
+
+/// Materiality of a significant candidate that is not a better sensor (diagnosis.cpp,
+/// "Materiality"): in the group where it removes most against the floor test's resolution, the
+/// in-sample mean square it removes, in units of the declared floor's mean square, and that
+/// resolution (upper_ratio - 1 of the declared floor's test).
+struct Materiality {
+  std::string group;
+  double removed = 0.0;
+  double resolution = 0.0;
+  bool reaches = false;  ///< the candidate's model passes its own floor test
+  /// It explains the excess the floor test found, or removes at least what that test resolves.
+  bool material() const { return reaches || removed >= resolution; }
+};
+/// `declared`: the declared model's floor; `extended`: the floor of the model with the candidate.
+Materiality materiality(const NoiseFloor& declared, const NoiseFloor& extended);
 
 /// Why `value` +- `std` is implausible for `info`: outside its physical bounds by more than two
 /// standard deviations (a parameter that may truly lie near a bound, a rolling resistance near 0,
