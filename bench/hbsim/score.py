@@ -24,6 +24,7 @@ import json
 import math
 import os
 import re
+import statistics
 import sys
 
 # --------------------------------------------------------------------------------------------
@@ -413,6 +414,31 @@ def consistency_findings(c):
             "statement": c.get("statement", "")}
 
 
+# The simulated sensor noise (1 sigma) of the channels the profile takes from 100 Hz messages, in
+# the product's units, transcribed from the hbsim README's bus table: at the grid's 100 Hz each
+# grid sample holds one frame's noise, so the product's measured white-noise std should match.
+# Channels from 50 Hz or slower messages (vx from the wheel speeds, engine speed, ...) are
+# interpolated onto the grid, which changes their noise's colour; they are left out.
+SIMULATED_NOISE = {
+    "yaw_rate": 0.08 * math.pi / 180.0,          # ChsYawVel 0.08 deg/s
+    "ay": 0.03, "ax": 0.03,                      # ChsAccLat, ChsAccLong (m/s^2)
+    "vy": 0.02,                                  # OptVy
+    "steer": 0.05 * math.pi / 180.0 / 15.5,      # EpsSwAngle 0.05 deg at the hand wheel
+    "wheel_torque": 2.0 * math.sqrt(2.0),        # WtmTrqRL + WtmTrqRR, 2 N m each
+}
+
+
+def channel_noise(reply):
+    """The channel noise the floor used on this run: the first trace's first round."""
+    for f in sorted(os.listdir(reply)):
+        if f.startswith("trace-") and not f.startswith("trace-ref-") and f.endswith(".json"):
+            t, _ = load_json(os.path.join(reply, f))
+            if t and t.get("rounds"):
+                chans = t["rounds"][0]["diagnosis"].get("floor", {}).get("channels", [])
+                return {c["channel"]: c["sigma"] for c in chans if c.get("sigma")}
+    return {}
+
+
 def fmt_pct(v):
     return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:+.2f}"
 
@@ -439,7 +465,7 @@ def main(argv=None):
         if not os.path.isdir(reply):
             continue
         t = timings(reply)
-        time_rows.append({"run": name, "timings": t})
+        time_rows.append({"run": name, "timings": t, "noise": channel_noise(reply)})
         models = run["target_models"] if run["kind"] == "effect" else list(run["truth"])
         estimates, _ = load_json(os.path.join(reply, "estimates.json"))
         cons, cons_err = load_json(os.path.join(reply, "consistency.json"))
@@ -550,6 +576,12 @@ def main(argv=None):
             secs = f"{u['seconds']:.1f} s" if u.get("seconds") is not None else "-"
             print(f"{u['run']:<30} {u['model']:<23} {secs:>8}  shown {','.join(u['shown']) or '-'}; {note}"
                   f"{'' if u['same_added'] else '; ADDED DIFFERS from the plain trace'}")
+
+    print("\n== channel noise: the floor's measured sigma / the simulated one (100 Hz channels), over runs")
+    for ch, sim in SIMULATED_NOISE.items():
+        ratios = sorted(tr["noise"][ch] / sim for tr in time_rows if ch in tr.get("noise", {}))
+        if ratios:
+            print(f"{ch:<14} median {statistics.median(ratios):.3f}, range {ratios[0]:.3f}-{ratios[-1]:.3f} over {len(ratios)} runs")
 
     print("\n== request times (s)")
     for tr in time_rows:
