@@ -329,7 +329,8 @@ OwnFloor own_floor(const CandidateScore& c, const FloorInputs& in, const NoiseFl
 // Materiality: with thousands of rows a HAC Wald test finds structure far smaller than anything
 // that matters (measured on an independent car's clean steering runs: a yaw-rate "delay" of
 // 0 ms and derivative terms at p < 1e-5, each removing 0.00-0.05 of the yaw residual's ratio of
-// squares to its floor, while moving the cornering stiffnesses by up to 40 %). A missing effect
+// squares to its floor; a trace that added four such terms moved the front cornering stiffness by
+// 41 %). A missing effect
 // other than a better sensor is a finding only when it explains the excess the floor test found
 // (its model reaches its own floor) or removes, in some group, at least the smallest excess that
 // test resolves: upper_ratio - 1 of the declared floor's mean square (0.19-0.26 on runs of 1-3
