@@ -286,12 +286,12 @@ struct FloorInputs {
 struct OwnFloor {
   std::string below;    ///< why it fits noise; empty when it does not
   bool lowers = false;  ///< its floor is significantly under the declared one
-  /// Its model's residual passes that model's floor test (the same test, at the same level, as
-  /// the declared model's): the candidate explains the whole residual, not a part of it. True
-  /// when its floor cannot be computed (judged as the declared floor's missing effect).
-  bool reaches = true;
   GroupFloor worst;     ///< the group furthest above its floor (ratio / upper_ratio)
+  /// What it removes, and (`reaches`) whether its model's residual passes that model's floor
+  /// test (the same test, at the same level, as the declared model's): the candidate explains
+  /// the whole residual, not a part of it.
   Materiality materiality;
+  bool reaches() const { return materiality.reaches; }
 };
 
 OwnFloor own_floor(const CandidateScore& c, const FloorInputs& in, const NoiseFloor& declared) {
@@ -301,10 +301,13 @@ OwnFloor own_floor(const CandidateScore& c, const FloorInputs& in, const NoiseFl
   try {
     floor = noise_floor(in.model, effects, in.run, in.segments, in.noise, in.options);
   } catch (const InputError&) {
-    return {};  // the extended model's floor cannot be computed: judged as a missing effect
+    // The extended model's floor cannot be computed: judged as the declared floor's missing
+    // effect, one that explains the whole residual.
+    OwnFloor unknown;
+    unknown.materiality.reaches = true;
+    return unknown;
   }
   OwnFloor out;
-  out.reaches = floor.adequate();
   out.materiality = materiality(declared, floor);
   for (const GroupFloor& f : floor.groups)
     if (f.rows > 0 && (out.worst.rows == 0 || f.ratio / f.upper_ratio > out.worst.ratio / out.worst.upper_ratio))
@@ -409,13 +412,13 @@ void accept_best(Diagnosis& d, const FloorInputs& in, bool at_floor = false) {
       d.refused.push_back({c.effect, immaterial_text(c, own.materiality)});
       continue;
     }
-    (own.lowers ? sensors_better : own.reaches ? missing : partial).push_back(c);
+    (own.lowers ? sensors_better : own.reaches() ? missing : partial).push_back(c);
     floors.emplace(c.effect, own);
   }
   if (at_floor) missing.clear(), partial.clear();
   std::vector<CandidateScore> sensors_reaching;
   for (const CandidateScore& c : sensors_better)
-    if (floors.at(c.effect).reaches) sensors_reaching.push_back(c);
+    if (floors.at(c.effect).reaches()) sensors_reaching.push_back(c);
   std::vector<CandidateScore>& chosen = !missing.empty()          ? missing
                                         : !sensors_reaching.empty() ? sensors_reaching
                                         : !partial.empty()          ? partial
@@ -424,7 +427,7 @@ void accept_best(Diagnosis& d, const FloorInputs& in, bool at_floor = false) {
   prefer_simplest_within_one_error(chosen);
   d.accepted = chosen.front();
   const OwnFloor& own = floors.at(d.accepted->effect);
-  if (!own.reaches) d.partial = own.worst;
+  if (!own.reaches()) d.partial = own.worst;
   d.better_sensor = own.lowers;
   if (&chosen == &missing || &chosen == &partial)
     for (const CandidateScore& c : sensors_better)
