@@ -147,6 +147,33 @@ TEST(NoiseFloor, PreprocessingOneChannelAgainEqualsPreprocessingTheRun) {
   }
 }
 
+// The floor draws noise only for the channels the rows read: the kinematic model reads ax, and
+// vx through its derivative only; a channel it never reads (a yaw rate) gets no draw and leaves
+// the floor exactly as without it.
+TEST(NoiseFloor, OnlyTheChannelsTheRowsReadGetDraws) {
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  auto run = kinematic_run(3, 0.0);
+  Eigen::MatrixXd samples(run.samples.rows(), 3);
+  samples << run.samples, 0.1 * Eigen::VectorXd::LinSpaced(run.samples.rows(), -1.0, 1.0);
+  run.samples = samples;
+  run.announcement.channels.push_back({"yaw_rate", "rad/s"});
+  const auto segments = ingest::preprocess_offline(run);
+  const std::vector<ChannelNoise> read = {{"vx", 0.02, "declared"}, {"ax", 0.05, "declared"}};
+  std::vector<ChannelNoise> first = read, last = read;
+  first.insert(first.begin(), ChannelNoise{"yaw_rate", 0.01, "declared"});
+  last.push_back(ChannelNoise{"yaw_rate", 0.01, "declared"});
+  const std::vector<std::string> expected = {"vx", "ax"};
+  EXPECT_EQ(noise_floor(*model, {}, run, segments, first, {}).contributing, expected);
+  const NoiseFloor with = noise_floor(*model, {}, run, segments, last, {});
+  const NoiseFloor without = noise_floor(*model, {}, run, segments, read, {});
+  EXPECT_EQ(with.contributing, expected);
+  ASSERT_EQ(with.groups.size(), 1U);
+  ASSERT_EQ(without.groups.size(), 1U);
+  EXPECT_GT(with.groups[0].floor_rms, 0.0);
+  EXPECT_EQ(with.groups[0].floor_rms, without.groups[0].floor_rms);
+  EXPECT_EQ(with.groups[0].ratio, without.groups[0].ratio);
+}
+
 TEST(NoiseFloor, AModelThatLacksNothingIsAdequateAtTheStatedRate) {
   const auto model = model::make_model("kinematic_longitudinal", {});
   int adequate = 0;

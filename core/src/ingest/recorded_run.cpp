@@ -106,11 +106,26 @@ std::vector<PreprocessedSegment> preprocess_offline(const RecordedRun& run) {
 std::vector<PreprocessedSegment> preprocess_channel_again(const RecordedRun& run,
                                                           std::vector<PreprocessedSegment> segments,
                                                           Eigen::Index column) {
+  return preprocess_channel_again(run, std::move(segments), column, run.samples.col(column));
+}
+
+std::vector<PreprocessedSegment> preprocess_channel_again(const RecordedRun& run,
+                                                          std::vector<PreprocessedSegment> segments,
+                                                          Eigen::Index column,
+                                                          const Eigen::VectorXd& values) {
   const ChannelSpec& changed = run.announcement.channels.at(static_cast<std::size_t>(column));
-  RecordedRun one{run.announcement, run.first_sample_index, run.samples.col(column), run.valid};
+  if (values.size() != run.samples.rows())
+    throw InputError("preprocessing channel '" + changed.name +
+                     "' again: " + std::to_string(values.size()) + " samples, the run has " +
+                     std::to_string(run.samples.rows()));
+  RecordedRun one{run.announcement, run.first_sample_index, values, run.valid};
   one.announcement.channels = {changed};
   const std::vector<PreprocessedSegment> again = preprocess_offline(one);
-  if (again.size() != segments.size()) return preprocess_offline(run);  // not the same validity
+  if (again.size() != segments.size()) {  // not the same validity
+    RecordedRun whole = run;
+    whole.samples.col(column) = values;
+    return preprocess_offline(whole);
+  }
   // The derivative made from the channel, unless the run announces a channel of that name (which
   // preprocessing keeps as it is).
   const std::string derivative = "d_" + changed.name;

@@ -29,7 +29,8 @@ void ChannelSet::add(const std::string& name, const std::string& unit, Eigen::Ve
       if (valid(k) && !std::isfinite(values(k)))
         throw InputError("channel set: channel '" + name + "' is not finite at sample " +
                          std::to_string(k) + " (mark the stretch invalid first)");
-  channels_.emplace(name, Channel{unit, std::move(values)});
+  channels_.emplace(name,
+                    Channel{unit, std::make_shared<const Eigen::VectorXd>(std::move(values))});
 }
 
 void ChannelSet::replace(const std::string& name, Eigen::VectorXd values) {
@@ -48,7 +49,7 @@ void ChannelSet::replace(const std::string& name, Eigen::VectorXd values) {
 const Eigen::VectorXd& ChannelSet::operator[](const std::string& name) const {
   const auto it = channels_.find(name);
   if (it == channels_.end()) throw InputError("channel set: no channel '" + name + "'");
-  return it->second.values;
+  return *it->second.values;
 }
 
 const std::string& ChannelSet::unit(const std::string& name) const {

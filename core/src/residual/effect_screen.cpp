@@ -334,7 +334,7 @@ void locate_offset(CandidateScore& c, const SignalContext& in, const std::string
   for (int step = 0; step < 2; ++step) {
     const detail::FoldedRows rows = detail::fold_rows(in.model, with_offset(in.declared, channel, value), in.run,
                                                       in.rate, in.odmf, in.fit, false, &in.rows);
-    const Eigen::VectorXd x = detail::base_solution(detail::evaluate(rows, {}, in.weights).all);
+    const Eigen::VectorXd x = detail::solution(rows);
     at_value = score_offset(in, channel, unit, x, value);
     if (!at_value.testable || !std::isfinite(at_value.coefficient)) {
       // An offset with no value cannot be added (its name needs one): not a candidate after all.
@@ -667,7 +667,7 @@ ScreenResult screen_effects(const model::Model& model, const std::vector<std::st
     const DelayProfile profile = profile_delay(delays, channel, max);
     const detail::FoldedRows at_found = detail::fold_rows(model, with_delay(declared, channel, profile.samples, sample_rate_hz),
                                                           run, sample_rate_hz, odmf, fold_options, false, &declared_rows);
-    const Eigen::VectorXd x_found = detail::base_solution(detail::evaluate(at_found, {}, weights).all);
+    const Eigen::VectorXd x_found = detail::solution(at_found);
     const CandidateScore along = score_delay(delays, channel, x_found, profile.samples);
     const double inflation = std::pow(along.coefficient_std / along.coefficient_textbook_std, 2);
     const LocatedDelay found = delay_interval(profile, inflation);

@@ -157,9 +157,13 @@ std::vector<std::vector<Eigen::VectorXd>> centred_series(const std::vector<Varyi
 
 }  // namespace
 
-FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& effects,
-                     const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
-                     int odmf, const FitOptions& options, bool collect, const RowSelection* only) {
+namespace {
+
+// fold_rows, or (`fold` false) its collected rows alone, nothing folded.
+FoldedRows build_rows(const model::Model& model, const std::vector<std::string>& effects,
+                      const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
+                      int odmf, const FitOptions& options, bool collect, const RowSelection* only,
+                      bool fold) {
   cancellation_point();  // each fit of the residual loop passes here
   options.cross_validation.validate();
   if (odmf < 1) throw InputError("residual analysis: odmf " + std::to_string(odmf) + " < 1");
@@ -260,8 +264,11 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
         row.back() = gr.y(static_cast<Eigen::Index>(i));
         const Eigen::Index grid = seg.first + sample;
         const double t = static_cast<double>(grid) / sample_rate_hz;
-        auto& dest = buffers.values[static_cast<std::size_t>(options.cross_validation.fold_of(t))][g];
-        dest.insert(dest.end(), row.begin(), row.end());
+        if (fold) {
+          auto& dest =
+              buffers.values[static_cast<std::size_t>(options.cross_validation.fold_of(t))][g];
+          dest.insert(dest.end(), row.begin(), row.end());
+        }
         if (collect) {
           out.collected.time_s[g].push_back(t);
           out.collected.grid_index[g].push_back(grid);
@@ -269,11 +276,55 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
         }
       }
     }
-    buffers.fold_into(out.folds, width);
+    if (fold) buffers.fold_into(out.folds, width);
   }
-  if (out.rows() == 0)
-    throw InputError("model " + model.name() + ": no row on the run (masking, or no valid segment)");
+  const bool none = fold ? out.rows() == 0
+                         : std::all_of(out.collected.values.begin(), out.collected.values.end(),
+                                       [](const std::vector<double>& v) { return v.empty(); });
+  if (none)
+    throw InputError("model " + model.name() +
+                     ": no row on the run (masking, or no valid segment)");
   return out;
+}
+
+}  // namespace
+
+FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& effects,
+                     const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
+                     int odmf, const FitOptions& options, bool collect, const RowSelection* only) {
+  return build_rows(model, effects, run, sample_rate_hz, odmf, options, collect, only, true);
+}
+
+bool reads_channel(const FoldedRows& base, const model::Model& model,
+                   const std::vector<std::string>& effects,
+                   const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
+                   int odmf, const FitOptions& options, const std::string& channel,
+                   const std::string& derivative, double scale) {
+  // Uniform in [-scale, scale) from a fixed linear congruential sequence: no model reads a
+  // channel in a way that such a perturbation leaves every row unchanged (a constant would pass
+  // through differences, a smooth one through a filter).
+  std::uint64_t state = 0x9e3779b97f4a7c15ULL;
+  const auto moved = [&](const Eigen::VectorXd& x) {
+    Eigen::VectorXd out = x;
+    for (Eigen::Index k = 0; k < out.size(); ++k) {
+      state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+      out(k) += scale * (static_cast<double>(state >> 11) * 0x1.0p-52 - 1.0);
+    }
+    return out;
+  };
+  std::vector<ingest::PreprocessedSegment> changed = run;
+  for (ingest::PreprocessedSegment& s : changed)
+    for (const std::string& name : {channel, derivative})
+      if (!name.empty() && s.channels.has(name)) s.channels.replace(name, moved(s.channels[name]));
+  try {
+    const FoldedRows rows =
+        build_rows(model, effects, changed, sample_rate_hz, odmf, options, true, nullptr, false);
+    return rows.parameters.size() != base.parameters.size() ||
+           rows.collected.values != base.collected.values ||
+           rows.collected.grid_index != base.collected.grid_index;
+  } catch (const InputError&) {
+    return true;  // the rows cannot be built with the channel moved: they read it
+  }
 }
 
 GridResiduals residuals_at(const FoldedRows& rows, const Eigen::VectorXd& x) {
@@ -410,6 +461,10 @@ std::uint64_t Evaluation::total_rows() const {
   std::uint64_t n = 0;
   for (std::uint64_t r : rows) n += r;
   return n;
+}
+
+Eigen::VectorXd solution(const FoldedRows& rows) {
+  return base_solution(merged(rows.folds, -1, rows.groups).estimate().estimate);
 }
 
 Evaluation evaluate(const FoldedRows& rows, const std::vector<Eigen::Index>& columns,

@@ -52,6 +52,18 @@ FoldedRows fold_rows(const model::Model& model, const std::vector<std::string>& 
                      int odmf, const FitOptions& options, bool collect,
                      const RowSelection* only = nullptr);
 
+/// Whether the rows of fold_rows(model, effects, run, ..., collect = true) (`base`) read the
+/// channel `channel` of the run or `derivative` (the derivative preprocessing made from it; empty
+/// when the run announces its own): false only when, with every valid sample of both moved by
+/// a pseudo-random amount of up to `scale` (their noise), the same rows come out bit for bit.
+/// Its cost is building the rows once, without their fit: the noise floor asks it of every
+/// channel the run has, most of which a model does not read, instead of drawing noise for each.
+bool reads_channel(const FoldedRows& base, const model::Model& model,
+                   const std::vector<std::string>& effects,
+                   const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
+                   int odmf, const FitOptions& options, const std::string& channel,
+                   const std::string& derivative, double scale);
+
 /// The rows `model` with `effects` (a road profile or a varying parameter among them changes no
 /// row; a delay does) keeps on the decimation grid of `run`. Throws InputError as fold_rows.
 RowSelection kept_rows(const model::Model& model, const std::vector<std::string>& effects,
@@ -91,6 +103,10 @@ FoldedRows with_extra_column(const FoldedRows& base, const std::vector<std::vect
 
 /// The solution with NaN (not identifiable) entries set to 0: the base-parameter solution.
 Eigen::VectorXd base_solution(const ls::Estimate& estimate);
+
+/// base_solution of the fit on all rows: evaluate(rows, ...).x without the held-out fits (a
+/// noise draw or a located effect needs the solution only).
+Eigen::VectorXd solution(const FoldedRows& rows);
 
 /// The weighted least-squares regression of collected column `column` on the collected columns
 /// `on`, each group's rows weighted by `weights` (per group of rows.groups): the coefficients b

@@ -214,11 +214,12 @@ struct ScaleSums {
   std::vector<std::vector<LagSums>> share;  // [channel][group]
 };
 
-ingest::RecordedRun with_noise(const ingest::RecordedRun& run, Eigen::Index column, double sigma,
-                               std::mt19937_64& rng) {
-  ingest::RecordedRun noisy = run;
+// Channel `column` of the run with fresh noise of `sigma`.
+Eigen::VectorXd with_noise(const ingest::RecordedRun& run, Eigen::Index column, double sigma,
+                           std::mt19937_64& rng) {
+  Eigen::VectorXd noisy = run.samples.col(column);
   std::normal_distribution<double> normal(0.0, 1.0);
-  for (Eigen::Index i = 0; i < noisy.samples.rows(); ++i) noisy.samples(i, column) += sigma * normal(rng);
+  for (Eigen::Index i = 0; i < noisy.size(); ++i) noisy(i) += sigma * normal(rng);
   return noisy;
 }
 
@@ -398,12 +399,15 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
   FitOptions fit_options = options.fit;
   fit_options.series = false;
   const detail::FoldedRows base = detail::fold_rows(model, effects, segments, rate, odmf, fit_options, true);
-  const Eigen::VectorXd x = detail::evaluate(base, {}, {}).x;
+  const Eigen::VectorXd x = detail::solution(base);
   const detail::GridResiduals r0 = detail::residuals_at(base, x);
   const detail::RowSelection rows = detail::kept_rows(model, effects, segments, rate, odmf);
   // One channel at a time: the floor is the sum of the channels' shares, and each share's
-  // uncertainty (its sigma's, measured) is carried on its own. A channel the model does not
-  // read leaves the residual exactly unchanged at the first draw and gets no more.
+  // uncertainty (its sigma's, measured) is carried on its own. A channel the rows do not read
+  // (most of a car's) gets no draw: its noise would leave the residual exactly unchanged. Its
+  // first draw is still taken from the generator, so that the other channels' draws, and the
+  // floor, do not depend on how the question was asked. A channel the rows read whose noise
+  // leaves the residual unchanged all the same gets one draw.
   std::vector<std::vector<LagSums>> shares;  // [channel][group]
   std::vector<ScaleSums> scale_shares(kBlockRows.size());
   std::vector<double> share_relative_variance;
@@ -412,16 +416,24 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
   for (const ChannelNoise& c : noise) {
     const Eigen::Index column = column_of(run.announcement, c.channel);
     if (column < 0 || !(c.sigma > 0.0)) continue;
+    const std::string derivative =
+        column_of(run.announcement, "d_" + c.channel) < 0 ? "d_" + c.channel : "";
+    if (!detail::reads_channel(base, model, effects, segments, rate, odmf, fit_options, c.channel,
+                               derivative, c.sigma)) {
+      with_noise(run, column, c.sigma, rng);
+      continue;
+    }
     std::vector<LagSums> sums(r0.size());
     std::vector<std::vector<LagSums>> blocks(kBlockRows.size(), std::vector<LagSums>(r0.size()));
     for (int d = 0; d < options.draws; ++d) {
       cancellation_point();
-      const auto noisy = ingest::preprocess_channel_again(with_noise(run, column, c.sigma, rng), segments, column);
+      const auto noisy = ingest::preprocess_channel_again(run, segments, column,
+                                                          with_noise(run, column, c.sigma, rng));
       // Refitted: the draw's own least squares, so that the attenuation its noise causes in the
       // parameters of a noisy regressor (errors in variables, slow like the signals) is in the
       // share, as the run's own noise put it into the run's residual (header, 2.).
       const detail::FoldedRows folded = detail::fold_rows(model, effects, noisy, rate, odmf, fit_options, true, &rows);
-      const detail::GridResiduals r1 = detail::residuals_at(folded, detail::evaluate(folded, {}, {}).x);
+      const detail::GridResiduals r1 = detail::residuals_at(folded, detail::solution(folded));
       for (std::size_t g = 0; g < sums.size(); ++g) {
         const auto share = difference(r1[g], r0[g]);
         sums[g].add(share, odmf);

@@ -19,17 +19,15 @@ Eigen::VectorXd shifted(const Eigen::VectorXd& values, Eigen::Index samples) {
   return out;
 }
 
+// A copy of `set` (sharing the channels no delay touches) with the delayed channels, and their
+// derivatives, read on time.
 model::ChannelSet delayed_set(const model::ChannelSet& set, const std::vector<SignalDelay>& delays) {
   const Eigen::Index n = set.samples();
-  model::ChannelSet out(set.sample_period(), n);
+  model::ChannelSet out = set;
   for (const std::string& name : set.names()) {
     const std::string base = name.rfind("d_", 0) == 0 ? name.substr(2) : name;
     const auto d = std::find_if(delays.begin(), delays.end(), [&](const SignalDelay& s) { return s.channel == base; });
-    if (d == delays.end()) {
-      out.add(name, set.unit(name), set[name]);
-      continue;
-    }
-    out.add(name, set.unit(name), shifted(set[name], d->samples));
+    if (d != delays.end()) out.replace(name, shifted(set[name], d->samples));
   }
   for (Eigen::Index k = 0; k < n; ++k) {
     bool ok = set.valid(k);

@@ -63,15 +63,15 @@ Eigen::MatrixXd standard_noise(Eigen::Index samples, std::size_t channels, std::
 
 // The run with `scale` sigma_c z_c added to every channel c of `noisy`, preprocessed as
 // preprocess_offline would (only those channels filtered again).
-std::vector<ingest::PreprocessedSegment> noisy_copy(const ingest::RecordedRun& run,
-                                                    const std::vector<ingest::PreprocessedSegment>& segments,
-                                                    const std::vector<Noisy>& noisy, const Eigen::MatrixXd& z,
-                                                    double scale) {
-  ingest::RecordedRun copy = run;
-  for (std::size_t c = 0; c < noisy.size(); ++c)
-    copy.samples.col(noisy[c].column) += (scale * noisy[c].sigma) * z.col(static_cast<Eigen::Index>(c));
+std::vector<ingest::PreprocessedSegment> noisy_copy(
+    const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
+    const std::vector<Noisy>& noisy, const Eigen::MatrixXd& z, double scale) {
   std::vector<ingest::PreprocessedSegment> out = segments;
-  for (const Noisy& c : noisy) out = ingest::preprocess_channel_again(copy, std::move(out), c.column);
+  for (std::size_t c = 0; c < noisy.size(); ++c) {
+    const Eigen::VectorXd values = run.samples.col(noisy[c].column) +
+                                   (scale * noisy[c].sigma) * z.col(static_cast<Eigen::Index>(c));
+    out = ingest::preprocess_channel_again(run, std::move(out), noisy[c].column, values);
+  }
   return out;
 }
 

@@ -55,6 +55,12 @@ std::vector<PreprocessedSegment> preprocess_offline(const RecordedRun& run);
 std::vector<PreprocessedSegment> preprocess_channel_again(const RecordedRun& run,
                                                           std::vector<PreprocessedSegment> segments,
                                                           Eigen::Index column);
+/// The same for `run` with channel `column`'s samples replaced by `values` (run.samples.rows()
+/// of them): the noise floor's draws change one channel and copy none of the others.
+std::vector<PreprocessedSegment> preprocess_channel_again(const RecordedRun& run,
+                                                          std::vector<PreprocessedSegment> segments,
+                                                          Eigen::Index column,
+                                                          const Eigen::VectorXd& values);
 
 /// True when a row is built at segment sample `i`: it lies on the run's decimation grid and at
 /// least segment.edge samples from both ends of the segment.

@@ -6,8 +6,11 @@
 // where signals enter: the car-side profile); `valid(k)` is false for samples inside a detected
 // gap or bad stretch, and models leave such rows out. Channel names follow the catalogue in
 // docs/CHANNELS.md. Adding a channel of the wrong length, a duplicate name, or a NaN/Inf at a
-// sample marked valid throws InputError naming the channel and sample.
+// sample marked valid throws InputError naming the channel and sample. A channel's values never
+// change once added (replace swaps in new ones), so copies of a set share them: copying a set, as
+// the residual loop does for every candidate and noise draw, costs its names, not its samples.
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -41,7 +44,7 @@ class ChannelSet {
  private:
   struct Channel {
     std::string unit;
-    Eigen::VectorXd values;
+    std::shared_ptr<const Eigen::VectorXd> values;  // shared by copies of the set
   };
   double sample_period_;
   Eigen::Index samples_;

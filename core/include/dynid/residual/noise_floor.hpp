@@ -11,7 +11,8 @@
 // 2. noise_floor: each channel's share of the residual, carried through the product's own path:
 //    `draws` copies of the raw run with fresh noise of that channel's sigma, preprocessed as the
 //    server does, rows built and fitted again; the floor is the sum of the shares, with its
-//    autocorrelation (the effective number of rows of a mean square, Bartlett).
+//    autocorrelation (the effective number of rows of a mean square, Bartlett). A channel the
+//    rows do not read (the rows come out the same with it moved) has no share and no draw.
 // 3. The verdict per equation group: log(residual mean square / floor mean square) against the
 //    normal quantile 1 - error_rate / groups, its variance the residual's (2 / n_eff) plus the
 //    floor's own (measurement bootstrap, draws). A model that lacks nothing is called
