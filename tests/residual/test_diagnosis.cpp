@@ -350,6 +350,29 @@ TEST(SensorOffset, NamesParseAndTheAngleAnAccelerometerOffsetMeans) {
 
 // A sensor scale that grows with the speed (a parameter that depends on a channel): explained
 // by depends:sensor_scale~vx, its slope recovered in the parameter's unit per unit of vx.
+// Step times: every block boundary but the first and the last on a short run; on an hour's run
+// every k-th, at most kMaxStepTimes per parameter, still on boundaries and evenly spread.
+TEST(VaryingParameter, StepTimesAreBlockBoundariesAtMostABoundedNumberPerParameter) {
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  const auto step_times = [&](double t_last) {
+    std::vector<double> out;
+    for (const std::string& name : varying_candidates(*model, 0.0, t_last, 5.0, {}, {}))
+      if (name.rfind("step:sensor_scale@", 0) == 0)
+        out.push_back(parse_varying_effect(name, *model).step_time_s);
+    return out;
+  };
+  EXPECT_EQ(step_times(40.0), (std::vector<double>{10, 15, 20, 25, 30, 35}));
+  const std::vector<double> hour = step_times(3600.0);
+  ASSERT_GE(hour.size(), static_cast<std::size_t>(kMaxStepTimes) - 1);
+  ASSERT_LE(hour.size(), static_cast<std::size_t>(kMaxStepTimes));
+  EXPECT_EQ(hour.front(), 10.0);
+  for (std::size_t i = 1; i < hour.size(); ++i) {
+    EXPECT_EQ(std::fmod(hour[i], 5.0), 0.0);
+    EXPECT_EQ(hour[i] - hour[i - 1], hour[1] - hour[0]);
+  }
+  EXPECT_GE(hour.back(), 3600.0 - 5.0 - (hour[1] - hour[0]));
+}
+
 TEST(Diagnosis, AParameterThatDependsOnAChannelIsExplainedByTheDependence) {
   auto run = kinematic_run(17, 0.0);
   const auto clean = kinematic_run(17, 0.0);

@@ -157,12 +157,17 @@ std::vector<std::string> varying_candidates(const model::Model& model, double t_
                                             double block_s, const std::vector<std::string>& channels,
                                             const std::vector<std::string>& quantities) {
   std::vector<std::string> out;
+  // Block boundaries from the second block's end to one block before the last sample.
+  const double first = (std::floor(t_first / block_s) + 2.0) * block_s;
+  int boundaries = 0;
+  while (first + boundaries * block_s <= t_last - block_s) ++boundaries;
+  const int every = std::max(1, (boundaries + kMaxStepTimes - 1) / kMaxStepTimes);
   for (const model::ParameterInfo& p : model.parameters()) {
     out.push_back(kDrift + p.name);
     for (const std::string& q : quantities) out.push_back(kDrift + p.name + "~" + q);
     for (const std::string& c : channels) out.push_back(kDepends + p.name + "~" + c);
-    for (double t0 = (std::floor(t_first / block_s) + 2.0) * block_s; t0 <= t_last - block_s; t0 += block_s)
-      out.push_back(kStep + p.name + "@" + seconds(t0) + "s");
+    for (int b = 0; b < boundaries; b += every)
+      out.push_back(kStep + p.name + "@" + seconds(first + b * block_s) + "s");
   }
   return out;
 }

@@ -26,12 +26,13 @@
 // any car whose profile maps those channels has them.
 // The residual screen offers a drift of every parameter of the model (with time and with every
 // cumulative quantity the run's channels allow), a step at every
-// cross-validation block boundary but the first and the last (a step needs data on both sides),
-// and a dependence of every parameter on every channel of the model's physics that is not on
-// its measured side; a step found is reported as a time. The column enters every equation group where W_j does.
-// On a run at nearly constant speed a drift or step of an offset and a road profile (a function
-// of distance) explain the same residual: the screen prefers the profile within one standard
-// error (effect_screen.hpp).
+// cross-validation block boundary but the first and the last (a step needs data on both sides;
+// on a run of more than kMaxStepTimes such boundaries, at every k-th, k the smallest that keeps
+// at most that many: see varying_candidates), and a dependence of every parameter on every channel
+// of the model's physics that is not on its measured side; a step found is reported as a time. The
+// column enters every equation group where W_j does. On a run at nearly constant speed a drift or
+// step of an offset and a road profile (a function of distance) explain the same residual: the
+// screen prefers the profile within one standard error (effect_screen.hpp).
 #include <optional>
 #include <string>
 #include <vector>
@@ -68,6 +69,16 @@ VaryingParameter parse_varying_effect(const std::string& name, const model::Mode
 
 /// The parameter the effect adds (no physical bounds: a change may have either sign).
 model::ParameterInfo varying_parameter_info(const VaryingParameter& v, const model::Model& model);
+
+/// The step times tried per parameter at most. Why a bound: each step time is a fit of the
+/// whole run, so with one per block the screen's cost grew with the square of the run's length
+/// (a 10-minute run: 118 per parameter), while a coarser grid loses little of a step's test: the
+/// tested time nearest a step at t* differs from it on at most half a spacing of rows (1/64 of
+/// the run), and the step's non-centrality falls by about that share of the shorter side's rows
+/// (a step mid-run: 3 %), less than the level gained by testing fewer times (Bonferroni over the
+/// candidates: 718 step times per parameter on an hour's run). The step found is then located
+/// on the rows themselves (change_point.hpp), at every row, whatever the grid.
+constexpr int kMaxStepTimes = 32;
 
 /// The names the screen tries on a run spanning [t_first, t_last] s with blocks of `block_s`,
 /// a dependence on each of `channels`, a drift with each of `quantities`.
