@@ -1,7 +1,7 @@
 // Which DBC files load unchanged. For every .dbc file given, or found in a folder given (sorted),
 // one line: "loads", "loads (N warnings, K messages not decoded)" or "refused: <error>"; then
-// the share that loads. dbc_load_share.sh builds it against the parser of any revision, so it
-// uses only the API that every revision has.
+// the share that loads. With -v, each warning follows its file. dbc_load_share.sh builds it against
+// the parser of any revision, so it uses only the API that every revision has.
 #include <algorithm>
 #include <cstdio>
 #include <exception>
@@ -15,7 +15,12 @@ namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
   std::vector<fs::path> files;
+  bool verbose = false;
   for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "-v") {
+      verbose = true;
+      continue;
+    }
     const fs::path arg(argv[i]);
     if (!fs::is_directory(arg)) {
       files.push_back(arg);
@@ -28,7 +33,7 @@ int main(int argc, char** argv) {
     files.insert(files.end(), found.begin(), found.end());
   }
   if (files.empty()) {
-    std::fprintf(stderr, "usage: dbc_load_share FILE.dbc|FOLDER...\n");
+    std::fprintf(stderr, "usage: dbc_load_share [-v] FILE.dbc|FOLDER...\n");
     return 2;
   }
   std::size_t loaded = 0;
@@ -44,6 +49,8 @@ int main(int argc, char** argv) {
       else
         std::printf("%s: loads (%zu warnings, %zu messages not decoded)\n", f.string().c_str(),
                     db.warnings.size(), not_decoded);
+      if (verbose)
+        for (const std::string& w : db.warnings) std::printf("  warning: %s\n", w.c_str());
     } catch (const std::exception& e) {
       std::printf("%s: refused: %s\n", f.string().c_str(), e.what());
     }

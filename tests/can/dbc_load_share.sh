@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Share of DBC files that load unchanged with the DBC parser of a git revision (docs/results/DBC.md).
-#   tests/can/dbc_load_share.sh REV PATH...
+#   tests/can/dbc_load_share.sh REV [-v] PATH...
 # REV: a git revision of this repository (main, HEAD, a hash), or "." for the work tree as it is.
-# PATH: a .dbc file or a folder of them. Builds tests/can/dbc_load_share.cpp (of the work tree)
+# PATH: a .dbc file or a folder of them; -v lists each file's warnings. Builds tests/can/dbc_load_share.cpp (of the work tree)
 # with that revision's parser sources in a temporary folder, with $CXX (default g++).
 set -euo pipefail
 if [[ $# -lt 2 ]]; then
-  echo "usage: $0 REV PATH..." >&2
+  echo "usage: $0 REV [-v] PATH..." >&2
   exit 2
 fi
 rev=$1
