@@ -1,10 +1,12 @@
 #include "can_test_support.hpp"
 
+#include <sys/wait.h>
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <dynid/can/dbc.hpp>
+#include <dynid/error.hpp>
 #include <memory>
-#include <sys/wait.h>
 
 namespace dynid::can::test {
 
@@ -19,6 +21,15 @@ std::vector<std::filesystem::path> opendbc_files() {
     if (e.path().extension() == ".dbc") out.push_back(e.path());
   std::sort(out.begin(), out.end());
   return out;
+}
+
+std::string dbc_error(const std::string& text, const std::string& name) {
+  try {
+    parse_dbc_string(text, name);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
 }
 
 std::string run_command(const std::string& command, int& status) {

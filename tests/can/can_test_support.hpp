@@ -13,6 +13,9 @@ std::filesystem::path rav4_dir();
 // Every *.dbc in opendbc/, sorted.
 std::vector<std::filesystem::path> opendbc_files();
 
+// The message of the InputError that parsing `text` as DBC file `name` throws, or "(no error)".
+std::string dbc_error(const std::string& text, const std::string& name = "bad.dbc");
+
 // Runs a shell command and returns its standard output; sets `status` to the exit code.
 std::string run_command(const std::string& command, int& status);
 

@@ -9,16 +9,20 @@
 #include <random>
 #include <sstream>
 
+#include "can_test_support.hpp"
+
 namespace dynid::can {
 namespace {
 
-std::string dbc_error(const std::string& text) {
-  try {
-    parse_dbc_string(text, "bad.dbc");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no error)";
+using test::dbc_error;
+
+// A problem confined to one message leaves the file readable and that message unusable: its
+// problem, or "(usable)". The message is the last one of the file.
+std::string message_problem(const std::string& text) {
+  const Database db = parse_dbc_string(text, "bad.dbc");
+  if (db.messages.empty()) return "(no message)";
+  const Message& m = db.messages.back();
+  return m.usable() ? "(usable)" : m.problem;
 }
 
 const std::string kGood = "BO_ 291 ENGINE: 8 ECU\n SG_ RPM : 0|16@1+ (0.25,0) [0|0] \"\" X\n";
@@ -31,9 +35,6 @@ TEST(BadDbc, SyntaxErrorsNameFileLineAndReason) {
             "found '2'");
   EXPECT_EQ(dbc_error(kGood + " SG_ B : 0|8@1+ (1,0 [0|0] \"\" X\n"),
             "bad.dbc:3: SG_ 'B': expected ')' after offset, found '['");
-  EXPECT_EQ(dbc_error("BO_ 1 A: 65 X\n"), "bad.dbc:1: BO_ 'A': size 65 exceeds 64 bytes");
-  EXPECT_EQ(dbc_error("BO_ 1 A: 8 X\nBO_ 1 B: 8 X\n"),
-            "bad.dbc:2: BO_ 'B': id 1 is already used by message 'A'");
   EXPECT_EQ(dbc_error(" SG_ A : 0|8@1+ (1,0) [0|0] \"\" X\n"),
             "bad.dbc:1: SG_: signal outside a message (no BO_ before it)");
   EXPECT_EQ(dbc_error("CM_ \"never closed;\n\n"),
@@ -45,21 +46,29 @@ TEST(BadDbc, SyntaxErrorsNameFileLineAndReason) {
   EXPECT_EQ(dbc_error(kGood + "} oops\n"), "bad.dbc:3: }: expected a section keyword, found '}'");
 }
 
+// Layout errors are confined to their message: the file loads, the message is unusable and
+// keeps the error (tests/can/test_dbc_wild.cpp has the warnings and the lookups).
 TEST(BadDbc, LayoutErrorsNameTheSignal) {
-  EXPECT_EQ(dbc_error(kGood + " SG_ L : 0|65@1+ (1,0) [0|0] \"\" X\n"),
+  EXPECT_EQ(message_problem(kGood + " SG_ L : 0|65@1+ (1,0) [0|0] \"\" X\n"),
             "bad.dbc:3: SG_ 'L': length 65 is outside 1..64 bits");
-  EXPECT_EQ(dbc_error(kGood + " SG_ L : 510|8@1+ (1,0) [0|0] \"\" X\n"),
+  EXPECT_EQ(message_problem(kGood + " SG_ L : 510|8@1+ (1,0) [0|0] \"\" X\n"),
             "bad.dbc:3: SG_ 'L': bits run past byte 64 (start 510, length 8)");
-  EXPECT_EQ(dbc_error(kGood + " SG_ RPM : 16|8@1+ (1,0) [0|0] \"\" X\n"),
-            "bad.dbc:3: SG_ 'RPM': duplicate signal name in message 'ENGINE'");
-  EXPECT_EQ(dbc_error(kGood + " SG_ F : 16|16@1+ (1,0) [0|0] \"\" X\nSIG_VALTYPE_ 291 F : 1;\n"),
-            "bad.dbc:3: SG_ 'F': a float signal (SIG_VALTYPE_ 1) must be 32 bits long, not 16");
-  EXPECT_EQ(dbc_error(kGood + " SG_ M3 m3 : 16|8@1+ (1,0) [0|0] \"\" X\n"),
+  EXPECT_EQ(message_problem(kGood + " SG_ RPM : 16|8@1+ (1,0) [0|0] \"\" X\n"),
+            "bad.dbc:3: SG_ 'RPM': duplicate signal name in message 'ENGINE': line 2 has it too, "
+            "and both can be in one frame");
+  EXPECT_EQ(
+      message_problem(kGood + " SG_ F : 16|16@1+ (1,0) [0|0] \"\" X\nSIG_VALTYPE_ 291 F : 1;\n"),
+      "bad.dbc:3: SG_ 'F': a float signal (SIG_VALTYPE_ 1) must be 32 bits long, not 16");
+  EXPECT_EQ(message_problem(kGood + " SG_ M3 m3 : 16|8@1+ (1,0) [0|0] \"\" X\n"),
             "bad.dbc:3: SG_ 'M3': multiplexed (m3) but message 'ENGINE' has no switch signal (M)");
-  EXPECT_EQ(dbc_error("BO_ 1 A: 8 X\n SG_ S1 m1M : 0|4@1+ (1,0) [0|0] \"\" X\n"
-                      " SG_ S2 m1M : 4|4@1+ (1,0) [0|0] \"\" X\n"
-                      "SG_MUL_VAL_ 1 S1 S2 1-1;\nSG_MUL_VAL_ 1 S2 S1 1-1;\n"),
+  EXPECT_EQ(message_problem("BO_ 1 A: 8 X\n SG_ S1 m1M : 0|4@1+ (1,0) [0|0] \"\" X\n"
+                            " SG_ S2 m1M : 4|4@1+ (1,0) [0|0] \"\" X\n"
+                            "SG_MUL_VAL_ 1 S1 S2 1-1;\nSG_MUL_VAL_ 1 S2 S1 1-1;\n"),
             "bad.dbc:2: SG_ 'S1': multiplexer switches form a cycle");
+  EXPECT_EQ(message_problem("BO_ 1 A: 65 X\n"), "bad.dbc:1: BO_ 'A': size 65 exceeds 64 bytes");
+  EXPECT_EQ(message_problem("BO_ 1 A: 8 X\nBO_ 1 B: 8 X\n"),
+            "bad.dbc:2: BO_ 'B': id 1 is already used by message 'A' (line 1)");
+  EXPECT_EQ(message_problem(kGood), "(usable)");
 }
 
 TEST(BadDbc, MissingFile) {

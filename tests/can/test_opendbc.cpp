@@ -21,6 +21,7 @@ TEST(OpenDbc, AllFilesParse) {
       EXPECT_GT(db.messages.size(), 0U);
       EXPECT_GT(db.signal_count(), 0U);
       for (const Message& m : db.messages) {
+        EXPECT_TRUE(m.usable()) << m.problem;
         if (m.is_pseudo) continue;
         EXPECT_EQ(db.find_message(m.id, m.extended), &m) << m.name;
       }

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <string>
 
@@ -250,6 +252,59 @@ TEST(CarProfile, PreprocessingPerVehicleWithTodaysDefaults) {
                "'ax' is not a channel of this profile");
   expect_error(base + "noise = { vx = -0.1 }\n", ":28:", "preprocessing.noise.vx", "must be > 0");
   expect_error(base + "cutoff = 5.0\n", ":28:", "preprocessing.cutoff", "unknown key");
+}
+
+// A DBC as production files are: messages the profile does not use carry an ambiguous signal
+// name, a layout error, a name that two messages share. The profile that does not use them
+// loads; one that selects them is refused with the reason and the DBC's lines.
+const std::string kWildDbc =
+    "BO_ 100 WHEELS: 8 X\n"
+    " SG_ SPEED : 0|16@1+ (0.01,0) [0|0] \"m/s\" X\n"
+    "BO_ 200 RADAR: 8 X // the radar repeats CHECKSUM in each group\n"
+    " SG_ MUX M : 0|1@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ CHECKSUM m0 : 56|8@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ CHECKSUM m1 : 56|8@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ RANGE_RATE m0 : 8|16@1- (0.01,0) [0|0] \"m/s\" X\n"
+    "BO_ 300 BROKEN: 8 X\n"
+    " SG_ LONG : 0|65@1+ (1,0) [0|0] \"m/s\" X\n"
+    "BO_ 400 TWIN: 8 X\n"
+    " SG_ V : 0|16@1+ (0.01,0) [0|0] \"m/s\" X\n"
+    "BO_ 401 TWIN: 8 X\n"
+    " SG_ V : 0|16@1+ (0.01,0) [0|0] \"m/s\" X\n";
+
+std::string wild_profile(const std::filesystem::path& dbc, const std::string& message,
+                         const std::string& signal) {
+  return "[vehicle]\nid = \"t\"\ndbc = \"" + dbc.string() +
+         "\"\n[grid]\nrate_hz = 100.0\nchunk_seconds = 0.5\n[spool]\ndirectory = \"spool\"\n"
+         "max_bytes = 1000000\n[[channels]]\nname = \"vx\"\nmessage = \"" +
+         message + "\"\nsignal = \"" + signal + "\"\n";
+}
+
+TEST(CarProfile, AWildDbcServesTheMessagesAProfileCanUse) {
+  const test::ScratchDir dir("wild-dbc");
+  const auto dbc = dir.path() / "wild.dbc";
+  std::ofstream(dbc) << kWildDbc;
+  const VehicleProfile p =
+      parse_vehicle_profile(wild_profile(dbc, "WHEELS", "SPEED"), profile_path("broken.toml"));
+  EXPECT_EQ(p.channels.at(0).dbc_message->id, 100U);
+  EXPECT_EQ(p.dbc->warnings.size(),
+            3U);  // the ambiguous name, the unusable message, the shared name
+  const VehicleProfile radar =
+      parse_vehicle_profile(wild_profile(dbc, "RADAR", "RANGE_RATE"), profile_path("broken.toml"));
+  EXPECT_EQ(radar.channels.at(0).inputs.at(0).index, 3U);
+
+  expect_error(
+      wild_profile(dbc, "RADAR", "CHECKSUM"), ":13:", "channels[0].signal",
+      "DBC signal 'CHECKSUM' of message 'RADAR' is ambiguous: wild.dbc defines it 2 times, "
+      "at lines 5 and 6 (under different multiplexer values)");
+  expect_error(
+      wild_profile(dbc, "BROKEN", "LONG"), ":12:", "channels[0].message",
+      "DBC message 'BROKEN' cannot be decoded: wild.dbc:9: SG_ 'LONG': length 65 is outside "
+      "1..64 bits");
+  expect_error(
+      wild_profile(dbc, "TWIN", "V"), ":12:", "channels[0].message",
+      "DBC message name 'TWIN' is ambiguous: wild.dbc has 2 messages of that name, ids 0x190 "
+      "(line 10) and 0x191 (line 12)");
 }
 
 TEST(CarProfile, SyntaxAndFileErrors) {

@@ -1,6 +1,6 @@
 // Fuzz target: the DBC parser (can/dbc.hpp) on arbitrary text. InputError is the documented
 // outcome for a bad file; a parsed database must answer its own lookups and decode frames of
-// its messages without fault (the decoder's contract: it never throws).
+// its usable messages without fault (the decoder's contract: it never throws).
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -19,7 +19,15 @@ void decode_every_message(const dynid::can::Database& db, std::string_view text)
   dynid::can::Decoder decoder(db);
   std::vector<dynid::can::DecodedSignal> out;
   for (const auto& message : db.messages) {
-    dynid::fuzz::expect(db.find_message(message.name) != nullptr, "a parsed message is found by name");
+    const auto named = db.find_messages(message.name);
+    dynid::fuzz::expect(std::find(named.begin(), named.end(), &message) != named.end(),
+                        "a parsed message is among the messages of its name");
+    dynid::fuzz::expect(db.find_message(message.name) == (named.size() == 1 ? &message : nullptr),
+                        "a name finds its message unless several messages have it");
+    const bool found_by_id = db.find_message(message.id, message.extended) == &message;
+    dynid::fuzz::expect(message.usable() ? found_by_id || message.is_pseudo : !found_by_id,
+                        "a usable message, and no other, is found by its id");
+    if (!message.usable()) continue;  // its layout may be impossible: never decoded
     dynid::can::Frame frame;
     frame.id = message.id;
     frame.extended = message.extended;

@@ -268,6 +268,36 @@ double read_sign(const Reader& r, const toml::table& t, const std::string& key) 
   return static_cast<double>(*v);
 }
 
+// "a", "a and b", "a, b and c".
+std::string listing(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i)
+    out += (i == 0 ? "" : (i + 1 == items.size() ? " and " : ", ")) + items[i];
+  return out;
+}
+
+// The one usable message of the DBC called `name`; else the reason, with the DBC's lines.
+const can::Message* dbc_message(const Reader& r, const VehicleProfile& p, const std::string& name,
+                                const std::string& key, const toml::table& t) {
+  const std::string file = p.dbc_path.filename().string();
+  const auto found = p.dbc->find_messages(name);
+  if (found.empty())
+    r.fail(key + ".message", "unknown DBC message '" + name + "' in " + file, t.get("message"));
+  if (found.size() > 1) {
+    std::vector<std::string> ids;
+    for (const can::Message* m : found)
+      ids.push_back(can::id_text(*m) + " (line " + std::to_string(m->line) + ")");
+    r.fail(key + ".message",
+           "DBC message name '" + name + "' is ambiguous: " + file + " has " +
+               std::to_string(found.size()) + " messages of that name, ids " + listing(ids),
+           t.get("message"));
+  }
+  if (!found[0]->usable())
+    r.fail(key + ".message", "DBC message '" + name + "' cannot be decoded: " + found[0]->problem,
+           t.get("message"));
+  return found[0];
+}
+
 ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml::table& t,
                             const std::string& key, bool in_source = false) {
   if (in_source)  // a channel of a second bus (type = "can" source)
@@ -284,12 +314,19 @@ ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml
   if (!unit) r.fail(key + ".name", "unknown channel '" + m.channel + "' (see docs/CHANNELS.md)", t.get("name"));
   m.unit = *unit;
   m.message = r.string(t, "message", key + ".message");
-  m.dbc_message = p.dbc->find_message(m.message);
-  if (m.dbc_message == nullptr)
-    r.fail(key + ".message", "unknown DBC message '" + m.message + "' in " + p.dbc_path.filename().string(),
-           t.get("message"));
+  m.dbc_message = dbc_message(r, p, m.message, key, t);
   for (const auto& name : signal_names(r, t, key)) {
     auto index = m.dbc_message->signal_index(name);
+    if (const auto a = m.dbc_message->ambiguous_signals.find(name);
+        a != m.dbc_message->ambiguous_signals.end()) {
+      std::vector<std::string> lines;
+      for (const std::size_t line : a->second) lines.push_back(std::to_string(line));
+      r.fail(signals_key(t, key),
+             "DBC signal '" + name + "' of message '" + m.message + "' is ambiguous: " +
+                 p.dbc_path.filename().string() + " defines it " + std::to_string(lines.size()) +
+                 " times, at lines " + listing(lines) + " (under different multiplexer values)",
+             signals_node(t));
+    }
     if (!index)
       r.fail(signals_key(t, key), "unknown DBC signal '" + name + "' in message '" + m.message + "' of " +
                                       p.dbc_path.filename().string(),

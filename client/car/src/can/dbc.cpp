@@ -1,4 +1,5 @@
 // Database lookups and attribute resolution. The parser is in dbc_parser.cpp.
+#include <cstdio>
 #include <dynid/can/dbc.hpp>
 #include <dynid/can/frame.hpp>
 
@@ -28,9 +29,26 @@ const Message* Database::find_message(std::uint32_t id, bool extended) const {
 }
 
 const Message* Database::find_message(std::string_view name) const {
+  const Message* found = nullptr;
+  for (const Message& m : messages) {
+    if (m.name != name) continue;
+    if (found != nullptr) return nullptr;  // ambiguous
+    found = &m;
+  }
+  return found;
+}
+
+std::vector<const Message*> Database::find_messages(std::string_view name) const {
+  std::vector<const Message*> out;
   for (const Message& m : messages)
-    if (m.name == name) return &m;
-  return nullptr;
+    if (m.name == name) out.push_back(&m);
+  return out;
+}
+
+std::string id_text(const Message& m) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "0x%X", static_cast<unsigned>(m.is_pseudo ? m.dbc_id : m.id));
+  return std::string(buf) + (m.is_pseudo ? " (pseudo)" : m.extended ? " (extended)" : "");
 }
 
 std::size_t Database::signal_count() const {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <dynid/can/frame.hpp>
 #include <dynid/error.hpp>
+#include <unordered_map>
 
 namespace dynid::can::detail {
 namespace {
@@ -10,40 +11,91 @@ namespace {
 constexpr std::uint32_t kPseudoMessageId = 0xC0000000U;
 constexpr std::uint32_t kMaxBits = 64 * 8;
 
+std::string where(const Database& db, std::size_t line) {
+  return db.source + ":" + std::to_string(line) + ": ";
+}
+
+// Checks one message and fills its derived fields; throws InputError naming file:line for a
+// problem, and adds its warnings to the database only when it passes.
 class MessageChecker {
  public:
-  MessageChecker(Database& db, Message& m, std::size_t line,
-                 const std::vector<std::size_t>& signal_lines)
-      : db_(db), m_(m), line_(line), signal_lines_(signal_lines) {}
+  MessageChecker(Database& db, Message& m) : db_(db), m_(m) {}
 
   void run() {
     index_signals();
     for (std::size_t i = 0; i < m_.signals.size(); ++i) check_layout(i);
     if (m_.required_bytes > m_.size && !m_.is_pseudo)
-      db_.warnings.push_back(where(line_) + "BO_ '" + m_.name + "': signals need " +
-                             std::to_string(m_.required_bytes) + " bytes but the size is " +
-                             std::to_string(m_.size));
+      warnings_.push_back(where(db_, m_.line) + "BO_ '" + m_.name + "': signals need " +
+                          std::to_string(m_.required_bytes) + " bytes but the size is " +
+                          std::to_string(m_.size));
     for (std::size_t i = 0; i < m_.signals.size(); ++i) link_multiplexer(i);
+    check_repeated_names();
     order_for_decoding();
     const auto format = attribute_value(db_, m_.attributes, "VFrameFormat");
     const auto* name = format ? std::get_if<std::string>(&*format) : nullptr;
     m_.fd = m_.size > Frame::kMaxClassicData ||
             (name != nullptr && name->find("FD") != std::string::npos);
+    db_.warnings.insert(db_.warnings.end(), warnings_.begin(), warnings_.end());
   }
 
  private:
-  std::string where(std::size_t line) const {
-    return db_.source + ":" + std::to_string(line) + ": ";
-  }
   [[noreturn]] void fail(std::size_t i, const std::string& reason) const {
-    throw InputError(where(signal_lines_[i]) + "SG_ '" + m_.signals[i].name + "': " + reason);
+    throw InputError(where(db_, m_.signals[i].line) + "SG_ '" + m_.signals[i].name +
+                     "': " + reason);
   }
 
+  // A name carried once goes to signal_by_name; repeated names wait for check_repeated_names.
   void index_signals() {
     m_.signal_by_name.clear();
-    for (std::size_t i = 0; i < m_.signals.size(); ++i)
-      if (!m_.signal_by_name.emplace(m_.signals[i].name, i).second)
-        fail(i, "duplicate signal name in message '" + m_.name + "'");
+    m_.ambiguous_signals.clear();
+    repeated_.clear();
+    std::unordered_map<std::string_view, std::vector<std::size_t>> by_name;
+    for (std::size_t i = 0; i < m_.signals.size(); ++i) by_name[m_.signals[i].name].push_back(i);
+    for (auto& [name, copies] : by_name) {
+      if (copies.size() == 1)
+        m_.signal_by_name.emplace(std::string(name), copies[0]);
+      else
+        repeated_.push_back(std::move(copies));
+    }
+    std::sort(repeated_.begin(), repeated_.end());  // file order, for the warnings
+  }
+  bool is_repeated(std::string_view name) const {
+    for (const auto& copies : repeated_)
+      if (m_.signals[copies[0]].name == name) return true;
+    return false;
+  }
+
+  // A name repeated under values of one switch that never select two of its signals together
+  // (radar messages repeat CHECKSUM in each group) is ambiguous: each copy decodes, no profile
+  // selects the name. Repeated where two copies can be in one frame, the message is unusable.
+  void check_repeated_names() {
+    for (const auto& copies : repeated_) {
+      for (std::size_t a = 1; a < copies.size(); ++a)
+        for (std::size_t b = 0; b < a; ++b)
+          if (!exclusive(m_.signals[copies[b]], m_.signals[copies[a]]))
+            fail(copies[a], "duplicate signal name in message '" + m_.name + "': line " +
+                                std::to_string(m_.signals[copies[b]].line) +
+                                " has it too, and both can be in one frame");
+      const std::string& name = m_.signals[copies[0]].name;
+      std::vector<std::size_t>& lines = m_.ambiguous_signals[name];
+      std::string list;
+      for (const std::size_t i : copies) {
+        lines.push_back(m_.signals[i].line);
+        list += (list.empty() ? "" : ", ") + std::to_string(m_.signals[i].line);
+      }
+      warnings_.push_back(where(db_, lines[0]) + "SG_ '" + name +
+                          "': " + std::to_string(copies.size()) + " signals of message '" +
+                          m_.name + "' have this name (lines " + list +
+                          ") under different multiplexer values: each decodes, but a profile "
+                          "cannot select the name");
+    }
+  }
+  static bool exclusive(const Signal& x, const Signal& y) {
+    if (x.multiplexer_index < 0 || x.multiplexer_index != y.multiplexer_index) return false;
+    for (const MuxRange& rx : x.mux_ranges)
+      for (const MuxRange& ry : y.mux_ranges)
+        if (rx.low <= ry.high && ry.low <= rx.high) return false;
+    return true;
   }
 
   void check_layout(std::size_t i) {
@@ -74,6 +126,9 @@ class MessageChecker {
       return;
     }
     if (s.multiplexer.empty()) s.multiplexer = plain_switch(i);
+    if (is_repeated(s.multiplexer))
+      fail(i, "multiplexer switch '" + s.multiplexer + "' is ambiguous: several signals of '" +
+                  m_.name + "' have that name");
     const auto it = m_.signal_by_name.find(s.multiplexer);
     if (it == m_.signal_by_name.end())
       fail(i, "multiplexer switch '" + s.multiplexer + "' is not a signal of '" + m_.name + "'");
@@ -115,10 +170,25 @@ class MessageChecker {
 
   Database& db_;
   Message& m_;
-  std::size_t line_;
-  const std::vector<std::size_t>& signal_lines_;
   std::vector<int> state_;
+  std::vector<std::vector<std::size_t>> repeated_;  // indices of each repeated name's signals
+  std::vector<std::string> warnings_;
 };
+
+// Two messages with one name both decode by id; the name selects neither.
+void warn_shared_names(Database& db) {
+  std::unordered_map<std::string_view, std::size_t> first;
+  for (std::size_t i = 0; i < db.messages.size(); ++i) {
+    const Message& m = db.messages[i];
+    const auto [it, fresh] = first.emplace(m.name, i);
+    if (fresh) continue;
+    const Message& f = db.messages[it->second];
+    db.warnings.push_back(where(db, m.line) + "BO_ '" + m.name +
+                          "': name also used by the message at line " + std::to_string(f.line) +
+                          " (id " + id_text(f) + "; this one: " + id_text(m) +
+                          "): both decode by id, a profile cannot select them by name");
+  }
+}
 
 }  // namespace
 
@@ -156,9 +226,28 @@ ByteSpan signal_bytes(const Signal& s) {
   return {first, first + (s.length - in_first + 7) / 8};
 }
 
-void finalize_database(Database& db, const SourceLines& lines) {
-  for (std::size_t i = 0; i < db.messages.size(); ++i)
-    MessageChecker(db, db.messages[i], lines.messages[i], lines.signals[i]).run();
+void finalize_database(Database& db, std::size_t last_line) {
+  for (Message& m : db.messages) {
+    if (!m.usable()) continue;  // the parser found its problem
+    try {
+      MessageChecker(db, m).run();
+    } catch (const InputError& e) {
+      m.problem = e.what();
+    }
+  }
+  db.message_by_key.clear();
+  for (std::size_t i = 0; i < db.messages.size(); ++i) {
+    const Message& m = db.messages[i];
+    if (m.usable()) {
+      db.message_by_key.emplace(message_key(m.dbc_id), i);
+      continue;
+    }
+    db.warnings.push_back(m.problem + "; message '" + m.name + "' (line " + std::to_string(m.line) +
+                          ") is unusable: not decoded, and a profile cannot select it");
+  }
+  warn_shared_names(db);
+  if (db.messages.empty())
+    db.warnings.push_back(where(db, last_line) + "the file defines no message (BO_)");
 }
 
 }  // namespace dynid::can::detail

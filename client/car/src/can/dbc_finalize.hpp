@@ -8,12 +8,6 @@
 
 namespace dynid::can::detail {
 
-// Source line of every message and signal, for error messages raised after parsing.
-struct SourceLines {
-  std::vector<std::size_t> messages;
-  std::vector<std::vector<std::size_t>> signals;
-};
-
 // The key under which a BO_ id is stored and referenced (Database::message_by_key): the DBC
 // id, except that ids above 0x7FF written without bit 31 (common in opendbc) get bit 31, since
 // only a 29-bit frame can carry them.
@@ -32,7 +26,9 @@ struct ByteSpan {
 ByteSpan signal_bytes(const Signal& s);
 
 // Validates layouts and multiplexing, fills Message::required_bytes, decode_order, fd,
-// signal_by_name and Signal::multiplexer_index. Throws InputError naming file:line.
-void finalize_database(Database& db, const SourceLines& lines);
+// signal_by_name, ambiguous_signals and Signal::multiplexer_index. A message with a problem
+// (found here or by the parser) is left unusable, with a warning, and out of the id index;
+// messages that share a name get a warning. Throws nothing for a message's problem.
+void finalize_database(Database& db, std::size_t last_line);
 
 }  // namespace dynid::can::detail

@@ -26,14 +26,24 @@ class Lexer {
   }
 
  private:
-  // Skips blanks and line ends; returns false at the end of the text.
+  // A line ends with LF, CRLF or a lone CR (old Mac files): true when text_[i] ends one. In CRLF
+  // the LF ends the line.
+  bool ends_line(std::size_t i) const {
+    return text_[i] == '\n' ||
+           (text_[i] == '\r' && (i + 1 >= text_.size() || text_[i + 1] != '\n'));
+  }
+
+  // Skips blanks, line ends and "//" comments (to the end of their line, as cantools does);
+  // returns false at the end of the text.
   bool skip_space() {
     while (pos_ < text_.size()) {
       const char c = text_[pos_];
-      if (c == '\n') {
+      if (ends_line(pos_)) {
         ++line_;
         line_start_ = pos_ + 1;
         at_line_start_ = true;
+      } else if (c == '/' && pos_ + 1 < text_.size() && text_[pos_ + 1] == '/') {
+        while (pos_ + 1 < text_.size() && !ends_line(pos_ + 1)) ++pos_;
       } else if (c != ' ' && c != '\t' && c != '\r' && c != '\f' && c != '\v') {
         return true;
       }
@@ -103,7 +113,8 @@ class Lexer {
     return std::string(text_.substr(begin, pos_ - begin));
   }
 
-  // Strings may span lines; \" and \\ are escapes, any other backslash is kept as written.
+  // Strings may span lines (a line end is kept as '\n'); \" and \\ are escapes, any other
+  // backslash is kept as written. "//" in a string is text, not a comment.
   std::string read_string() {
     const std::size_t open_line = line_;
     std::string out;
@@ -115,11 +126,13 @@ class Lexer {
         out.push_back(text_[pos_++]);
         continue;
       }
-      if (c == '\n') {
+      if (ends_line(pos_ - 1)) {  // kept as '\n', whichever line end the file uses
         ++line_;
         line_start_ = pos_;
+        out.push_back('\n');
+      } else if (c != '\r') {
+        out.push_back(c);
       }
-      if (c != '\r') out.push_back(c);
     }
     throw InputError(std::string(name_) + ":" + std::to_string(open_line) +
                      ": unterminated string (opening quote has no closing quote)");

@@ -3,7 +3,8 @@
 //
 // DBC is a free-form token language whose statements mostly start at the beginning of a line;
 // the lexer keeps each token's line and whether it opens its line, which the parser uses to
-// end statements that have no terminator (BO_, SG_, BU_) and to skip unknown sections.
+// end statements that have no terminator (BO_, SG_, BU_) and to skip unknown sections. Lines
+// end with LF, CRLF or a lone CR; "//" outside a string starts a comment up to the line's end.
 #include <cstddef>
 #include <string>
 #include <string_view>

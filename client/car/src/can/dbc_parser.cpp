@@ -35,7 +35,7 @@ class Parser {
 
   Database run() {
     while (peek().kind != TokenKind::End) statement();
-    detail::finalize_database(db_, lines_);
+    detail::finalize_database(db_, peek().line);
     return std::move(db_);
   }
 
@@ -50,10 +50,13 @@ class Parser {
   // True when the current statement has ended: the next token opens a line.
   bool at_line_end() const { return peek().opens_line; }
 
+  // "<name>:<line>: <context>: <reason>", escaped: the file's bytes (names, tokens) reach it.
+  std::string located(const Token& at, std::string_view reason) const {
+    return name_ + ":" + std::to_string(at.line) + ": " +
+           input::printable_text(context_ + ": " + std::string(reason));
+  }
   [[noreturn]] void fail(const Token& at, std::string_view reason) const {
-    // Escaped: the file's bytes (names, tokens) reach the message.
-    throw InputError(name_ + ":" + std::to_string(at.line) + ": " +
-                     input::printable_text(context_ + ": " + std::string(reason)));
+    throw InputError(located(at, reason));
   }
   [[noreturn]] void fail_expected(std::string_view what) const {
     fail(peek(), "expected " + std::string(what) + ", found " + detail::describe(peek()));
@@ -128,6 +131,8 @@ class Parser {
     if (t.kind != TokenKind::Identifier)
       fail(t, "expected a section keyword, found " + detail::describe(t));
     const std::string& k = t.text;
+    const bool in_message = in_message_;  // the previous statement was a BO_ or one of its SG_
+    in_message_ = k == "BO_" || k == "SG_";
     if (k == "VERSION") return version();
     if (k == "NS_") return new_symbols();
     if (k == "BS_" || k == "BU_") return node_list(k == "BU_");
@@ -144,7 +149,24 @@ class Parser {
     if (k == "BO_TX_BU_") return transmitters();
     if (k == "EV_") return environment_variable();
     if (k == "SIG_GROUP_") return signal_group();
+    if (kKeywords.count(k) != 0) return skip_section();  // a section this parser does not use
+    // An unknown word: skipped with what follows, up to the next section keyword. Among the
+    // signals of a message a signal may be lost there, so that message is unusable.
+    const Token& at = t;
+    const std::size_t first_line = at.line;
     skip_section();
+    const std::string span =
+        peek().line - 1 > first_line
+            ? "lines " + std::to_string(first_line) + "-" + std::to_string(peek().line - 1)
+            : "line " + std::to_string(first_line);
+    unknown_word_ =
+        "line " + std::to_string(first_line) + " starts with the unknown word '" + at.text + "'";
+    if (!in_message) return warn(at, "unknown section keyword: " + span + " skipped");
+    Message& m = db_.messages.back();
+    in_message_ = true;  // its SG_ lines may follow
+    if (m.usable())
+      m.problem = located(at, "unknown section keyword among the signals of message '" + m.name +
+                                  "' (" + span + " skipped): a signal may be missing");
   }
 
   // Skips to the next line that starts with a section keyword.
@@ -161,52 +183,66 @@ class Parser {
     db_.version = expect_string("a version string after VERSION");
   }
 
-  // NS_ lists the optional symbols, one per indented line, until a line starts at column 1.
+  // NS_ lists the optional symbols, one per indented line, until a line starts at column 1
+  // or with BS_, BU_ or BO_ (never optional symbols; some files indent them).
   void new_symbols() {
     take();
     if (at_punct(':')) take();
-    while (peek().kind != TokenKind::End && !(peek().opens_line && peek().column == 1))
+    while (peek().kind != TokenKind::End && !(peek().opens_line && peek().column == 1) &&
+           !(peek().opens_line && (at_ident("BS_") || at_ident("BU_") || at_ident("BO_"))))
       db_.new_symbols.push_back(take().text);
   }
 
-  // "BS_: [baud : btr1, btr2]" (ignored) and "BU_: node node ...".
+  // "BS_: [baud : btr1, btr2]" (ignored) and "BU_: node node ...". The nodes may go on over
+  // indented lines (one per line in Tesla's files).
   void node_list(bool nodes) {
     take();
     expect_punct(':', "after " + context_);
-    while (!at_line_end()) {
+    while (!at_line_end() || (nodes && peek().kind == TokenKind::Identifier && peek().column > 1 &&
+                              kKeywords.count(peek().text) == 0)) {
       const Token& t = take();
       if (nodes && t.kind == TokenKind::Identifier) db_.nodes.push_back(Node{t.text, {}, {}});
       else if (nodes) fail(t, "expected a node name, found " + detail::describe(t));
     }
   }
 
+  // Problems of the message alone (size, an id another message has) make it unusable.
   void message() {
     take();
     const Token& id_token = peek();
     const std::uint32_t raw_id = expect_u32("a message id");
     Message m;
+    m.line = id_token.line;
     m.name = expect_ident("a message name");
     context_ = "BO_ '" + m.name + "'";
     if (const std::string why = detail::set_message_id(m, raw_id); !why.empty())
       warn(id_token, why);
     const std::uint32_t key = detail::message_key(raw_id);
-    if (!db_.message_by_key.emplace(key, db_.messages.size()).second)
-      fail(id_token, "id " + id_token.text + " is already used by message '" +
-                         db_.messages[db_.message_by_key.at(key)].name + "'");
+    if (const auto [it, fresh] = db_.message_by_key.emplace(key, db_.messages.size()); !fresh) {
+      Message& first = db_.messages[it->second];  // references keep going to the first
+      m.problem = located(id_token, "id " + id_token.text + " is already used by message '" +
+                                        first.name + "' (line " + std::to_string(first.line) + ")");
+      if (first.usable())
+        first.problem = name_ + ":" + std::to_string(first.line) + ": " +
+                        input::printable_text("BO_ '" + first.name + "': id " + id_token.text +
+                                              " is also used by message '" + m.name + "' (line " +
+                                              std::to_string(m.line) + ")");
+    }
     expect_punct(':', "after the message name");
     const Token& size_token = peek();
     m.size = expect_u32("the message size");
-    if (m.size > 64) fail(size_token, "size " + size_token.text + " exceeds 64 bytes");
+    if (m.size > 64 && m.usable())
+      m.problem = located(size_token, "size " + size_token.text + " exceeds 64 bytes");
     m.transmitter = expect_ident("the transmitting node");
     if (!at_line_end()) fail_expected("the end of the line after the transmitter");
     db_.messages.push_back(std::move(m));
-    lines_.messages.push_back(id_token.line);
-    lines_.signals.emplace_back();
   }
 
   void signal() {
     const Token& keyword = take();
-    if (db_.messages.empty()) fail(keyword, "signal outside a message (no BO_ before it)");
+    if (db_.messages.empty())
+      fail(keyword, "signal outside a message (no BO_ before it" +
+                        (unknown_word_.empty() ? std::string() : "; " + unknown_word_) + ")");
     Signal s;
     s.name = expect_ident("a signal name");
     context_ = "SG_ '" + s.name + "'";
@@ -229,8 +265,8 @@ class Parser {
     expect_punct(']', "after maximum");
     s.unit = expect_string("the unit string");
     s.receivers = name_list();
+    s.line = keyword.line;
     db_.messages.back().signals.push_back(std::move(s));
-    lines_.signals.back().push_back(keyword.line);
   }
 
   // "M" (switch), "m3" (selected by value 3), "m3M" (both: extended multiplexing).
@@ -284,12 +320,15 @@ class Parser {
     warn(at, "message id " + std::to_string(raw_id) + " is not defined by a BO_");
     return nullptr;
   }
-  Signal* signal_ref(const Token& at, Message* m, const std::string& name) {
-    if (m == nullptr) return nullptr;
+  // Every signal of `m` called `name`: a repeated name is ambiguous, and a reference to it
+  // applies to each copy (as in cantools, which keys them by name).
+  std::vector<Signal*> signal_refs(const Token& at, Message* m, const std::string& name) {
+    std::vector<Signal*> out;
+    if (m == nullptr) return out;
     for (Signal& s : m->signals)
-      if (s.name == name) return &s;
-    warn(at, "message '" + m->name + "' has no signal '" + name + "'");
-    return nullptr;
+      if (s.name == name) out.push_back(&s);
+    if (out.empty()) warn(at, "message '" + m->name + "' has no signal '" + name + "'");
+    return out;
   }
   Node* node_ref(const Token& at, const std::string& name) {
     for (Node& n : db_.nodes)
@@ -312,7 +351,7 @@ class Parser {
     AttributeScope scope = AttributeScope::Network;
     Node* node = nullptr;
     Message* message = nullptr;
-    Signal* signal = nullptr;
+    std::vector<Signal*> signals;
     EnvironmentVariable* env = nullptr;
     bool dangling = false;
   };
@@ -338,8 +377,8 @@ class Parser {
         t.dangling = true;
         return t;
       }
-      if (sig) t.signal = signal_ref(at, t.message, expect_ident("a signal name"));
-      t.dangling = sig ? t.signal == nullptr : t.message == nullptr;
+      if (sig) t.signals = signal_refs(at, t.message, expect_ident("a signal name"));
+      t.dangling = sig ? t.signals.empty() : t.message == nullptr;
     } else if (at_ident("EV_")) {
       take();
       t.scope = AttributeScope::EnvVar;
@@ -359,7 +398,9 @@ class Parser {
       case AttributeScope::Network: db_.comment = std::move(text); break;
       case AttributeScope::Node: t.node->comment = std::move(text); break;
       case AttributeScope::Message: t.message->comment = std::move(text); break;
-      case AttributeScope::Signal: t.signal->comment = std::move(text); break;
+      case AttributeScope::Signal:
+        for (Signal* s : t.signals) s->comment = text;
+        break;
       case AttributeScope::EnvVar: t.env->comment = std::move(text); break;
     }
   }
@@ -446,7 +487,9 @@ class Parser {
       case AttributeScope::Network: db_.network_attributes[name] = std::move(v); break;
       case AttributeScope::Node: t.node->attributes[name] = std::move(v); break;
       case AttributeScope::Message: t.message->attributes[name] = std::move(v); break;
-      case AttributeScope::Signal: t.signal->attributes[name] = std::move(v); break;
+      case AttributeScope::Signal:
+        for (Signal* s : t.signals) s->attributes[name] = v;
+        break;
       case AttributeScope::EnvVar: t.env->attributes[name] = std::move(v); break;
     }
   }
@@ -483,8 +526,8 @@ class Parser {
     const std::string sig = expect_ident("a signal name");
     context_ = "VAL_ '" + sig + "'";
     Message* m = message_ref(at, id);
-    auto pairs = value_pairs();
-    if (Signal* s = signal_ref(at, m, sig)) s->value_descriptions = std::move(pairs);
+    const auto pairs = value_pairs();
+    for (Signal* s : signal_refs(at, m, sig)) s->value_descriptions = pairs;
   }
 
   // ---- signal extras --------------------------------------------------------------------
@@ -499,7 +542,7 @@ class Parser {
     const std::uint64_t code = expect_uint("the value type (0, 1 or 2)");
     if (code > 2) fail(vt, "value type " + vt.text + " is not 0 (integer), 1 (float) or 2 (double)");
     expect_semicolon();
-    if (Signal* s = signal_ref(at, m, sig)) s->value_type = static_cast<ValueType>(code);
+    for (Signal* s : signal_refs(at, m, sig)) s->value_type = static_cast<ValueType>(code);
   }
 
   // "SG_MUL_VAL_ <id> <signal> <switch> 3-3, 5-10 ;". The lexer reads "3-3" as 3 and -3.
@@ -526,7 +569,7 @@ class Parser {
       if (at_punct(',')) take();
     }
     expect_semicolon();
-    if (Signal* s = signal_ref(at, m, sig)) {
+    for (Signal* s : signal_refs(at, m, sig)) {
       s->multiplexer = sw;
       s->mux_ranges.insert(s->mux_ranges.end(), ranges.begin(), ranges.end());
     }
@@ -580,8 +623,9 @@ class Parser {
   std::vector<Token> tokens_;
   std::size_t pos_ = 0;
   std::string context_;
+  bool in_message_ = false;
+  std::string unknown_word_;  // the last one skipped, for the error of a lost BO_
   Database db_;
-  detail::SourceLines lines_;
 };
 
 }  // namespace

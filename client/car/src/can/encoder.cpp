@@ -14,6 +14,9 @@ std::vector<std::optional<double>> values_by_index(const Message& m,
   std::vector<std::optional<double>> out(m.signals.size());
   for (const SignalValue& v : values) {
     const auto i = m.signal_index(v.name);
+    if (!i && m.ambiguous_signals.count(v.name) != 0)
+      throw InputError("message '" + m.name + "': signal name '" + std::string(v.name) +
+                       "' is ambiguous (several SG_ of the message have it)");
     if (!i) throw InputError("message '" + m.name + "': no signal '" + std::string(v.name) + "'");
     if (!std::isfinite(v.value))
       throw InputError("message '" + m.name + "': signal '" + std::string(v.name) +
@@ -27,6 +30,8 @@ std::vector<std::optional<double>> values_by_index(const Message& m,
 
 EncodeReport encode_frame(const Message& message, std::span<const SignalValue> values,
                           Frame& frame) {
+  if (!message.usable())
+    throw InputError("message '" + message.name + "' cannot be encoded: " + message.problem);
   const auto given = values_by_index(message, values);
   std::array<std::uint8_t, Frame::kMaxFdData> data{};
   std::vector<bool> active(message.signals.size(), false);

@@ -6,12 +6,35 @@
 //   BU_, BO_ (bit 31 of the id = 29-bit extended id), SG_ (Intel "@1" and Motorola "@0",
 //   signed/unsigned, multiplexers "M", "m3", "m3M"), SIG_VALTYPE_ (IEEE float/double),
 //   SG_MUL_VAL_ (extended multiplexing ranges), VAL_TABLE_, VAL_, CM_ (multi-line, escaped
-//   quotes), BA_DEF_, BA_DEF_DEF_, BA_, BO_TX_BU_, EV_, SIG_GROUP_; CRLF and UTF-8 are fine.
-//   Other sections (BA_DEF_REL_, SGTYPE_, CAT_, FILTER, ...) are skipped.
-// - Syntax errors and inconsistent layouts (signal beyond 64 bytes, float signal not 32/64
-//   bits, multiplexer cycle, duplicate id) throw dynid::InputError "<name>:<line>: <what>:
-//   <reason>". References to objects the file does not define (CM_/BA_/VAL_ for an unknown
-//   message or signal) are not fatal: they are listed in Database::warnings with file:line.
+//   quotes), BA_DEF_, BA_DEF_DEF_, BA_, BO_TX_BU_, EV_, SIG_GROUP_. Lines end with LF, CRLF or
+//   a lone CR (old Mac files); UTF-8 is fine; "//" outside a string comments out the rest of
+//   its line (whole lines and trailing comments, as cantools reads them). The other sections of
+//   the format (BA_DEF_REL_, SGTYPE_, CAT_, FILTER, ...) are skipped silently.
+// - Syntax errors throw dynid::InputError "<name>:<line>: <what>: <reason>": the rest of the
+//   file cannot be read with confidence, so nothing of it is returned.
+// - A problem confined to one message does not refuse the file: the message is unusable
+//   (Message::problem holds the error, naming file:line), Database::warnings says so, and id
+//   lookups do not find it (its frames decode as unknown ids). Such problems: an inconsistent
+//   layout (signal beyond 64 bytes or outside 1..64 bits, float signal not 32/64 bits, size
+//   above 64 bytes, multiplexing without a switch or with a cycle), a signal name repeated in
+//   one message where both signals can be present in one frame, an id that another message
+//   also has (both are unusable), a line that starts with an unknown word after the message's
+//   BO_ or SG_ lines and before any other section (skipped up to the next section keyword; a
+//   signal may have been lost there).
+//   Derived fields (signal_by_name, decode_order, ...) of an unusable message may be unfilled.
+// - A signal name repeated under different values of the same switch (real radar messages do
+//   this): every copy decodes when its value is selected; the name is ambiguous
+//   (Message::ambiguous_signals, a warning naming the lines) and signal_index does not find it.
+//   CM_, VAL_, BA_, SIG_VALTYPE_ and SG_MUL_VAL_ naming it apply to every copy, as in cantools.
+// - Two messages with one name: both load and decode by id; a warning names both lines, and
+//   find_message(name) finds neither (find_messages lists them).
+// - Warnings (Database::warnings, "<name>:<line>: ...") also list references to objects the
+//   file does not define (CM_/BA_/VAL_ for an unknown message or signal), unknown words at the
+//   start of a line outside a message (skipped to the next section keyword), ids interpreted,
+//   a missing ';' before the next section, and a file without any message.
+// - A vehicle profile (car/vehicle_profile.hpp) that selects an unusable message, a message
+//   name that several messages have, or an ambiguous signal name is refused with the reason and
+//   the DBC lines; a profile that does not select them is unaffected.
 // - parse_dbc_file reads only a regular file of at most input::kMaxTextFileBytes (a FIFO, a
 //   directory or a device is refused: input/input_file.hpp).
 // - The returned Database is immutable in use: decoders keep pointers into it.
@@ -82,6 +105,7 @@ struct Signal {
 
   // Filled by the parser: index of the switch signal in the message, or -1.
   int multiplexer_index = -1;
+  std::size_t line = 0;  // of its SG_ in the file
 
   bool is_multiplexed() const { return mux_value.has_value(); }
   bool mux_accepts(std::uint64_t switch_raw) const;
@@ -113,8 +137,18 @@ struct Message {
   // Vector's VECTOR__INDEPENDENT_SIG_MSG (DBC id 0xC0000000) parks unused signals; it is never
   // on the bus, so id lookups do not find it.
   bool is_pseudo = false;
+  std::size_t line = 0;  // of its BO_ in the file
 
-  // Index of the signal called `name`, or nullopt. O(1).
+  // Empty when the message can be decoded. Otherwise the error that would have refused the
+  // file, "<name>:<line>: <what>: <reason>": the message is unusable (see the contract above).
+  std::string problem;
+  bool usable() const { return problem.empty(); }
+
+  // Names that several signals of the message carry under different values of their switch,
+  // with the lines of their SG_. Those signals decode; signal_index does not find them.
+  std::map<std::string, std::vector<std::size_t>, std::less<>> ambiguous_signals;
+
+  // Index of the signal called `name`, or nullopt (also for an ambiguous name). O(1).
   std::optional<std::size_t> signal_index(std::string_view signal_name) const;
   const Signal* find_signal(std::string_view signal_name) const;
 
@@ -159,11 +193,15 @@ struct Database {
   std::map<std::string, AttributeDefinition, std::less<>> attribute_definitions;
   Attributes network_attributes;
   std::string comment;
-  std::vector<std::string> warnings;  // "<name>:<line>: ..." for dangling references
+  std::vector<std::string> warnings;  // "<name>:<line>: ...", see the contract above
 
-  // Lookup by CAN id, O(1). Returns nullptr for an id the database does not describe.
+  // Lookup by CAN id, O(1). Returns nullptr for an id the database does not describe, or whose
+  // message is unusable.
   const Message* find_message(std::uint32_t id, bool extended) const;
+  // Lookup by name: nullptr when no message, or more than one, has that name.
   const Message* find_message(std::string_view name) const;
+  // Every message called `name`, in file order (usable or not).
+  std::vector<const Message*> find_messages(std::string_view name) const;
 
   // The DBC id as written (dbc_key, or 0xC0000000 for the pseudo message) -> index.
   std::unordered_map<std::uint32_t, std::size_t> message_by_key;
@@ -174,6 +212,9 @@ struct Database {
 // ENUM values are returned as their name. nullopt when neither exists.
 std::optional<AttributeValue> attribute_value(const Database& db, const Attributes& own,
                                               std::string_view name);
+
+// A message's id for people: "0x1C4", "0x18FFFFFE (extended)", "0xC0000000 (pseudo)".
+std::string id_text(const Message& m);
 
 Database parse_dbc_string(std::string_view text, std::string_view name);
 Database parse_dbc_file(const std::filesystem::path& path);

@@ -7,8 +7,9 @@
 //   whose switch (as encoded) does not select it is not written and is reported as inactive;
 //   signals not given stay raw 0.
 // - Values outside the raw range are clamped and reported (see physical_to_raw).
-// - Throws InputError naming message and signal for an unknown signal name or a NaN/Inf value;
-//   the frame is then unchanged.
+// - Throws InputError naming message and signal for an unknown or ambiguous signal name
+//   (Message::ambiguous_signals) or a NaN/Inf value, and for an unusable message
+//   (Message::problem); the frame is then unchanged.
 #include <dynid/can/dbc.hpp>
 #include <dynid/can/frame.hpp>
 #include <span>
