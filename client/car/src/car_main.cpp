@@ -140,8 +140,22 @@ SocketCanOptions live_bus_options() {
 
 // The profile of this run: the declared one with the auxiliary sources given (auxiliary.hpp),
 // their clocks put on the bus's (an estimate reads the replayed log once), reported.
+// What the DBC's parser passed over (messages it cannot use, ambiguous names, references to
+// nothing): a profile that reads such a message or name is refused at load; the rest is said,
+// not hidden.
+void report_dbc_warnings(const VehicleProfile& profile) {
+  constexpr std::size_t kShown = 5;
+  const std::vector<std::string>& warnings = profile.dbc->warnings;
+  if (warnings.empty()) return;
+  spdlog::warn("{}: {} warning{} from the DBC parser", profile.dbc_path.filename().string(),
+               warnings.size(), warnings.size() == 1 ? "" : "s");
+  for (std::size_t i = 0; i < warnings.size() && i < kShown; ++i) spdlog::warn("  {}", warnings[i]);
+  if (warnings.size() > kShown) spdlog::warn("  ... and {} more", warnings.size() - kShown);
+}
+
 RunSources run_profile(const Options& options) {
   const VehicleProfile declared = load_vehicle_profile(options.profile);
+  report_dbc_warnings(declared);
   std::map<std::string, std::filesystem::path> given;
   for (const auto& s : options.sources) {
     const std::size_t eq = s.find('=');
