@@ -182,9 +182,13 @@ RunSources run_profile(const Options& options) {
 // The auxiliary samples into the pipeline; what was merged is logged at the end.
 void log_auxiliary(const CarPipeline& pipe) {
   const AuxiliaryStats& a = pipe.auxiliary_stats();
-  if (a.merged + a.before_bus + a.after_bus == 0) return;
-  spdlog::info("auxiliary sources: {} samples merged into the grid, {} before the first frame and {} after the last "
-               "dropped", a.merged, a.before_bus, a.after_bus);
+  if (a.merged + a.before_bus + a.after_bus + a.out_of_range > 0)
+    spdlog::info(
+        "auxiliary sources: {} samples merged into the grid, {} before the first frame and {} "
+        "after the "
+        "last dropped",
+        a.merged, a.before_bus, a.after_bus);
+  for (const std::string& line : pipe.dropped_report()) spdlog::warn("{}", line);
 }
 
 // Lines of a log judged before anything of it is announced, spooled or written: enough to tell

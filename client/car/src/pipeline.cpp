@@ -24,7 +24,8 @@ ResamplerConfig resampler_config(const VehicleProfile& p) {
 
 CarPipeline::CarPipeline(const VehicleProfile& profile, const std::string& run,
                          ChunkBuilder::ChunkSink sink, std::uint64_t first_sequence)
-    : time_jumps_(resampler_config(profile).jumps),
+    : profile_(profile),
+      time_jumps_(resampler_config(profile).jumps),
       mapper_(profile),
       builder_(profile.vehicle, run, profile.channels.size(), profile.chunk_rows, std::move(sink),
                first_sequence),
@@ -58,6 +59,10 @@ void CarPipeline::push_auxiliary_until(double source_time) {
       ++aux_stats_.before_bus;
       continue;
     }
+    if (!aux_dropped_.keep(a.channel, a.time, a.value)) {
+      ++aux_stats_.out_of_range;
+      continue;
+    }
     resampler_.push(a.channel, run_time(a.time), a.value);
     ++aux_stats_.merged;
   }
@@ -72,6 +77,13 @@ void CarPipeline::on_frame(const can::Frame& frame) {
   for (const auto& s : samples_) resampler_.push(s.channel, t, s.value);
   // Every frame moves the clock, so a silent channel is declared stale in time.
   resampler_.advance_clock(t);
+}
+
+std::vector<std::string> CarPipeline::dropped_report() const {
+  std::vector<std::string> out = mapper_.dropped().report(profile_, "the bus");
+  for (std::string& line : aux_dropped_.report(profile_, "its source"))
+    out.push_back("auxiliary " + line);
+  return out;
 }
 
 void CarPipeline::idle(double time) {

@@ -19,7 +19,8 @@ ReplayProgress counts(const FrameSource& source, const MapStats& m) {
   p.decoded = m.decoded();
   p.mapped = m.mapped;
   p.unknown_id = m.unknown_id;
-  p.bad = source.bad_input() + m.short_payload + m.remote + m.non_finite + m.bad_time;
+  p.bad =
+      source.bad_input() + m.short_payload + m.remote + m.non_finite + m.out_of_range + m.bad_time;
   p.other_interface = m.other_interface;
   p.fraction = source.fraction_done();
   return p;

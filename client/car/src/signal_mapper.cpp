@@ -39,8 +39,8 @@ FrameOutcome SignalMapper::map(const can::Frame& frame, std::vector<ChannelSampl
   for (const auto& d : decoded_) physical_[d.index] = d.value;
   for (std::size_t c : it->second) {
     const double v = profile_.channels[c].value(physical_);
-    if (!std::isfinite(v)) {
-      ++stats_.non_finite;
+    if (!dropped_.keep(c, frame.timestamp, v)) {
+      ++(std::isfinite(v) ? stats_.out_of_range : stats_.non_finite);
       continue;
     }
     out.push_back({c, frame.timestamp, v});

@@ -37,6 +37,7 @@ struct AuxiliaryStats {
   std::uint64_t merged = 0;
   std::uint64_t before_bus = 0;  ///< dropped: before the run's first frame
   std::uint64_t after_bus = 0;   ///< dropped: after its last frame
+  std::uint64_t out_of_range = 0;  ///< dropped: a value no chunk may carry (dropped_samples.hpp)
 };
 
 class CarPipeline {
@@ -61,6 +62,9 @@ class CarPipeline {
   const ResamplerStats& resampler_stats() const { return resampler_.stats(); }
   std::uint64_t chunks() const { return builder_.chunks(); }
   const AuxiliaryStats& auxiliary_stats() const { return aux_stats_; }
+  /// The samples left out because no chunk may carry them (dropped_samples.hpp), one line per
+  /// channel of the bus and of the auxiliary sources.
+  std::vector<std::string> dropped_report() const;
   /// Where the frames' clock jumps (the profile's max_time_jump; the resampler's latency back).
   TimeJumpLimits time_jumps() const { return time_jumps_; }
   /// Source-clock time of grid index 0 (valid once the first sample arrived).
@@ -69,6 +73,7 @@ class CarPipeline {
   std::optional<double> first_time() const { return first_time_; }
 
  private:
+  const VehicleProfile& profile_;
   TimeJumpLimits time_jumps_;
   SignalMapper mapper_;
   ChunkBuilder builder_;
@@ -79,6 +84,7 @@ class CarPipeline {
   std::vector<AuxiliarySample> aux_;
   std::size_t aux_next_ = 0;
   AuxiliaryStats aux_stats_;
+  DroppedSamples aux_dropped_;
 
   double run_time(double source_time);
   void push_auxiliary_until(double source_time);

@@ -5,8 +5,9 @@
 // Contract: map() never throws for bad input. It classifies each frame (FrameOutcome) and counts
 // it in stats(): frames from interfaces the profile does not listen to, unknown ids, remote
 // frames and payloads too short for the message are counted and produce no sample; a frame
-// whose channel value is NaN/Inf (a float signal carrying garbage) produces no sample for that
-// channel and is counted as non_finite. A frame whose timestamp is not usable_time() (negative, or
+// whose channel value no chunk may carry (NaN/Inf, or beyond the chunk limit: dropped_samples.hpp)
+// produces no sample for that channel and is counted as non_finite or out_of_range, and under
+// its channel in dropped(). A frame whose timestamp is not usable_time() (negative, or
 // past kMaxTimestamp) is counted as bad_time and produces nothing: on such a clock a grid period
 // is below the resolution of a double (at 1e299 s, t + 0.01 == t), so the resampler could not
 // tell one row from the next. The profile must outlive the mapper.
@@ -17,6 +18,7 @@
 
 #include <dynid/can/decoder.hpp>
 
+#include "dynid/car/dropped_samples.hpp"
 #include "dynid/car/vehicle_profile.hpp"
 
 namespace dynid::car {
@@ -43,6 +45,7 @@ struct MapStats {
   std::uint64_t remote = 0;
   std::uint64_t short_payload = 0;
   std::uint64_t non_finite = 0;       ///< channel values dropped because NaN/Inf
+  std::uint64_t out_of_range = 0;     ///< channel values dropped: beyond what a chunk may carry
   std::uint64_t bad_time = 0;         ///< frames dropped: timestamp not usable_time()
   std::uint64_t decoded() const { return mapped + unmapped; }
 };
@@ -54,6 +57,7 @@ class SignalMapper {
   /// Appends the frame's channel samples to `out` (not cleared).
   FrameOutcome map(const can::Frame& frame, std::vector<ChannelSample>& out);
   const MapStats& stats() const { return stats_; }
+  const DroppedSamples& dropped() const { return dropped_; }
 
  private:
   const VehicleProfile& profile_;
@@ -62,6 +66,7 @@ class SignalMapper {
   std::vector<can::DecodedSignal> decoded_;
   std::vector<double> physical_;
   MapStats stats_;
+  DroppedSamples dropped_;
 };
 
 }  // namespace dynid::car
