@@ -1,6 +1,7 @@
 // A sample no chunk may carry (a float signal reading 1e20 or NaN: a sensor fault, a bit error
 // the CRC missed) is left out where it enters, counted and named with its channel; every chunk
 // of the run is one the server accepts, and the rows around it stay valid (dropped_samples.hpp).
+// A channel the log never fills is named with where it was to come from (pipeline.hpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -91,6 +92,28 @@ TEST(DroppedSamples, OneValueNoChunkMayCarryIsLeftOutAndTheRunDelivered) {
   EXPECT_NE(report[1].find("channel 'ax': 2 samples left out (the first NaN, at 6.101 s"),
             std::string::npos)
       << report[1];
+}
+
+// A channel the log never fills makes every row invalid: the report names it and where it was
+// to come from, instead of a bare count of invalid rows.
+TEST(DroppedSamples, AChannelThatNeverGetsAValueIsNamed) {
+  test::ScratchDir dir("never-filled");
+  const VehicleProfile profile = float_profile(dir);
+  std::vector<ingest::Chunk> chunks;
+  CarPipeline pipe(profile, "r1", [&](ingest::Chunk&& c) { chunks.push_back(std::move(c)); });
+  for (int i = 0; i < 300; ++i) {  // Motion only: no Accel frame, so no ax
+    const double speed = 20.0;
+    pipe.on_frame(frame(256, i * 0.01, &speed, 8));
+  }
+  pipe.finish();
+  const std::vector<std::string> report = pipe.missing_report();
+  ASSERT_EQ(report.size(), 1U);
+  EXPECT_NE(report[0].find("channel 'ax' had no value in "), std::string::npos) << report[0];
+  EXPECT_NE(
+      report[0].find(
+          "(no sample at all from message 'Accel', signal LongAccel): those rows are invalid"),
+      std::string::npos)
+      << report[0];
 }
 
 }  // namespace

@@ -180,7 +180,9 @@ RunSources run_profile(const Options& options) {
 }
 
 // The auxiliary samples into the pipeline; what was merged is logged at the end.
-void log_auxiliary(const CarPipeline& pipe) {
+// What the run left out: the auxiliary samples outside the bus's time, the samples no chunk may
+// carry, and the channels that made rows invalid, each named.
+void log_left_out(const CarPipeline& pipe) {
   const AuxiliaryStats& a = pipe.auxiliary_stats();
   if (a.merged + a.before_bus + a.after_bus + a.out_of_range > 0)
     spdlog::info(
@@ -189,6 +191,7 @@ void log_auxiliary(const CarPipeline& pipe) {
         "last dropped",
         a.merged, a.before_bus, a.after_bus);
   for (const std::string& line : pipe.dropped_report()) spdlog::warn("{}", line);
+  for (const std::string& line : pipe.missing_report()) spdlog::warn("{}", line);
 }
 
 // Lines of a log judged before anything of it is announced, spooled or written: enough to tell
@@ -221,7 +224,7 @@ std::string replay_log(const Options& options, CarPipeline& pipe,
   ro.progress_interval = 100ms;  // also how often acknowledgements are taken while replaying
   ro.on_progress = std::move(on_progress);
   const ReplayProgress done = replay(source, pipe, ro);
-  log_auxiliary(pipe);
+  log_left_out(pipe);
   if (done.rows > 0)  // where the run's times (row / rate) sit on the log's clock, e.g. to compare with its GNSS
     spdlog::info("grid row 0 is at {:.6f} s of the log's clock", pipe.origin());
   spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids, {} timestamps out of range), {:.1f} s of "
@@ -272,7 +275,7 @@ void read_bus(const Options& options, SocketCanSource& source, CarPipeline& pipe
   if (merge.stats().frames_forced > 0)
     spdlog::warn("{} frames let in at the end of a source's wait, a source behind them: the run's chunks may differ "
                  "from a replay of the same files", merge.stats().frames_forced);
-  log_auxiliary(pipe);
+  log_left_out(pipe);
   spdlog::info("bus {} closed: {} frames, {} error frames, {} dropped by the kernel, {} chunks", options.can,
                source.frames(), source.error_frames(), source.dropped(), pipe.chunks());
 }

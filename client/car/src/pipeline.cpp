@@ -86,6 +86,33 @@ std::vector<std::string> CarPipeline::dropped_report() const {
   return out;
 }
 
+std::vector<std::string> CarPipeline::missing_report() const {
+  const ResamplerStats& r = resampler_.stats();
+  std::vector<std::pair<std::uint64_t, std::size_t>> order;  // (rows missing, channel)
+  for (std::size_t c = 0; c < r.missing_by_channel.size() && c < profile_.channels.size(); ++c) {
+    const std::uint64_t missing = r.missing_by_channel[c];
+    if (missing >= 10 && 100 * missing >= r.rows) order.emplace_back(missing, c);
+  }
+  std::sort(order.rbegin(), order.rend());
+  std::vector<std::string> out;
+  for (const auto& [missing, c] : order) {
+    const ChannelMapping& m = profile_.channels[c];
+    std::string from;
+    if (m.source && *m.source < profile_.sources.size()) {
+      from = "auxiliary source '" + profile_.sources[*m.source].name + "'";
+    } else {
+      from = "message '" + m.message + "', signal";
+      for (std::size_t i = 0; i < m.inputs.size(); ++i)
+        from += (i == 0 ? " " : ", ") + m.inputs[i].signal;
+    }
+    out.push_back("channel '" + m.channel + "' had no value in " + std::to_string(missing) +
+                  " of " + std::to_string(r.rows) + " rows (" +
+                  (missing >= r.rows ? "no sample at all from " : "from ") + from +
+                  "): those rows are invalid");
+  }
+  return out;
+}
+
 void CarPipeline::idle(double time) {
   if (first_time_) resampler_.idle(run_time(time));
 }

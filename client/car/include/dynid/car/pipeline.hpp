@@ -65,6 +65,10 @@ class CarPipeline {
   /// The samples left out because no chunk may carry them (dropped_samples.hpp), one line per
   /// channel of the bus and of the auxiliary sources.
   std::vector<std::string> dropped_report() const;
+  /// The channels that had no value in at least 1 % of the rows (and 10 rows), most first, each
+  /// with where it comes from: what made those rows invalid ("channel 'yaw_rate' had no value in
+  /// 3991 of 3991 rows (no sample at all from message 'ESP_Dynamics', signal YawRate)").
+  std::vector<std::string> missing_report() const;
   /// Where the frames' clock jumps (the profile's max_time_jump; the resampler's latency back).
   TimeJumpLimits time_jumps() const { return time_jumps_; }
   /// Source-clock time of grid index 0 (valid once the first sample arrived).
