@@ -207,5 +207,23 @@ TEST(ClientDelivery, RejectionsAreReportedWithTheirReasonAndHoldTheRun) {
   EXPECT_TRUE(link.log.contains("server rejected the announcement of car-1/r1: announcement rejected: no channel"));
 }
 
+// The vehicle's other cars share its partition and see each other's receipts: another run's
+// rejection is not this car's, neither in its log nor in its count.
+TEST(ClientDelivery, AnotherRunsRejectionIsNotThisCarsNews) {
+  Link link("others", {}, true);
+  ASSERT_TRUE(link.connected);
+  auto& car = link.car;
+  for (const auto& c : make_chunks("car-1", "r1", 3)) car.delivery.submit(c);
+  ASSERT_TRUE(link.until([&] { return link.acker.distinct("r1") == 3; }));
+  link.acker.acknowledge("bound", 18,
+                         {{19, "row 99 (sample 1999), channel 'vx' = 2.5e19 exceeds the limit"}});
+  link.acker.acknowledge("r1", 2, {});
+  ASSERT_TRUE(link.until([&] { return car.spool.count() == 0; }));
+  car.delivery.service(200ms);
+  EXPECT_FALSE(link.log.contains("bound#19"));
+  EXPECT_EQ(car.delivery.stats().rejections, 0U);
+  EXPECT_TRUE(car.delivery.drain(300ms));
+}
+
 }  // namespace
 }  // namespace dynid::car

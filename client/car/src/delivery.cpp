@@ -28,8 +28,14 @@ Delivery::Delivery(Spool& spool, Uplink& uplink, DeliveryOptions options, Delive
   // A restart: the server may never have seen these runs (or lost nothing and acknowledges
   // them at once from its ledger); either way they are announced before their chunks.
   const auto runs = spool_.pending_announcements();
-  for (const auto& announcement : runs) uplink_.announce(announcement);
-  for (const auto& e : spool_.pending_entries()) queue_.push_back({e.vehicle, e.run, e.sequence, true});
+  for (const auto& announcement : runs) {
+    own_runs_.insert({announcement.vehicle, announcement.run});
+    uplink_.announce(announcement);
+  }
+  for (const auto& e : spool_.pending_entries()) {
+    own_runs_.insert({e.vehicle, e.run});
+    queue_.push_back({e.vehicle, e.run, e.sequence, true});
+  }
   if (!queue_.empty())
     log(LogLevel::info, "resuming: " + std::to_string(queue_.size()) + " unacknowledged chunks in the spool (" +
                             std::to_string(runs.size()) + " runs announced again), oldest " +
@@ -37,11 +43,13 @@ Delivery::Delivery(Spool& spool, Uplink& uplink, DeliveryOptions options, Delive
 }
 
 void Delivery::announce(const ingest::RunAnnouncement& announcement) {
+  own_runs_.insert({announcement.vehicle, announcement.run});
   spool_.store_announcement(announcement);
   uplink_.announce(announcement);
 }
 
 void Delivery::submit(const ingest::Chunk& chunk) {
+  own_runs_.insert({chunk.vehicle, chunk.run});
   if (!held_.empty()) {
     hold(chunk, {});  // behind the held ones: the spool stays a prefix of the run
   } else {
@@ -149,6 +157,7 @@ std::string Delivery::holdup() const {
 
 bool Delivery::on_receipt(const dds::ChunkReceipt& receipt) {
   known_runs_.insert({receipt.vehicle, receipt.run});
+  if (own_runs_.count({receipt.vehicle, receipt.run}) == 0) return false;  // another car's run
   bool pending_rejected = false;
   for (const auto& r : receipt.rejections) {
     // Rejections of chunks acknowledged since (a resend went through) are history.

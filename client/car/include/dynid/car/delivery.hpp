@@ -126,6 +126,9 @@ class Delivery {
   std::set<std::tuple<std::string, std::uint64_t, std::string>> rejections_seen_;
   std::map<std::pair<std::string, std::uint64_t>, std::string> rejected_;  // (run, seq) -> reason
   std::set<std::pair<std::string, std::string>> known_runs_;  // (vehicle, run) with a receipt
+  // (vehicle, run) this car announced or spooled: the receipts of the vehicle's other cars (they
+  // share its partition) are not its news.
+  std::set<std::pair<std::string, std::string>> own_runs_;
   DeliveryStats stats_;
 };
 
