@@ -81,7 +81,7 @@ void CarPipeline::on_frame(const can::Frame& frame) {
 
 std::vector<std::string> CarPipeline::dropped_report() const {
   std::vector<std::string> out = mapper_.dropped().report(profile_, "the bus");
-  for (std::string& line : aux_dropped_.report(profile_, "its source"))
+  for (std::string& line : aux_dropped_.report(profile_, "the bus"))
     out.push_back("auxiliary " + line);
   return out;
 }

@@ -34,9 +34,9 @@ class DroppedSamples {
   bool keep(std::size_t channel, double time, double value);
   std::uint64_t total() const;
   const std::map<std::size_t, Channel>& by_channel() const { return by_channel_; }
-  /// One line per channel: "channel 'vx': 1 sample left out (2.5e+19 at 12.340 s of the log's
-  /// clock; beyond the 1e+15 a chunk may carry)". `where` names the source ("the log", "source
-  /// 'gnss'").
+  /// One line per channel: "channel 'vx': 1 sample left out (the first 2.5e+19, beyond the
+  /// 1e+15 a chunk may carry, at 12.340 s of the bus's clock); ...". `where` names the clock the
+  /// times are on ("the bus": auxiliary samples are put on the bus's clock before they enter).
   std::vector<std::string> report(const VehicleProfile& profile, const std::string& where) const;
 
  private:
