@@ -147,9 +147,11 @@ TEST(NoiseFloor, PreprocessingOneChannelAgainEqualsPreprocessingTheRun) {
   }
 }
 
-// The floor draws noise only for the channels the rows read: the kinematic model reads ax, and
-// vx through its derivative only; a channel it never reads (a yaw rate) gets no draw and leaves
-// the floor exactly as without it.
+// The floor draws noise only for the channels the rows read (noise_floor.hpp, 2.): the kinematic
+// model reads ax, and vx through its derivative only, and both must still be drawn (a check that
+// missed the derivative would leave vx out of the floor); a channel it never reads (a yaw rate)
+// leaves the floor exactly as without it. That the unread channel costs no draw is not
+// observable here; bench/loop measures it.
 TEST(NoiseFloor, OnlyTheChannelsTheRowsReadGetDraws) {
   const auto model = model::make_model("kinematic_longitudinal", {});
   auto run = kinematic_run(3, 0.0);

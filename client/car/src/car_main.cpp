@@ -138,8 +138,6 @@ SocketCanOptions live_bus_options() {
   return o;
 }
 
-// The profile of this run: the declared one with the auxiliary sources given (auxiliary.hpp),
-// their clocks put on the bus's (an estimate reads the replayed log once), reported.
 // What the DBC's parser passed over (messages it cannot use, ambiguous names, references to
 // nothing): a profile that reads such a message or name is refused at load; the rest is said,
 // not hidden.
@@ -153,6 +151,8 @@ void report_dbc_warnings(const VehicleProfile& profile) {
   if (warnings.size() > kShown) spdlog::warn("  ... and {} more", warnings.size() - kShown);
 }
 
+// The profile of this run: the declared one with the auxiliary sources given (auxiliary.hpp),
+// their clocks put on the bus's (an estimate reads the replayed log once), reported.
 RunSources run_profile(const Options& options) {
   const VehicleProfile declared = load_vehicle_profile(options.profile);
   report_dbc_warnings(declared);
@@ -179,7 +179,6 @@ RunSources run_profile(const Options& options) {
   return run;
 }
 
-// The auxiliary samples into the pipeline; what was merged is logged at the end.
 // What the run left out: the auxiliary samples outside the bus's time, the samples no chunk may
 // carry, and the channels that made rows invalid, each named.
 void log_left_out(const CarPipeline& pipe) {

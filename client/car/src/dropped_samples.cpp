@@ -33,12 +33,6 @@ bool DroppedSamples::keep(std::size_t channel, double time, double value) {
   return false;
 }
 
-std::uint64_t DroppedSamples::total() const {
-  std::uint64_t n = 0;
-  for (const auto& [channel, c] : by_channel_) n += c.count;
-  return n;
-}
-
 std::vector<std::string> DroppedSamples::report(const VehicleProfile& profile,
                                                 const std::string& where) const {
   std::vector<std::string> out;

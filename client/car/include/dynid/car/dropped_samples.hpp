@@ -24,7 +24,7 @@ class DroppedSamples {
  public:
   struct Channel {
     std::uint64_t count = 0;
-    double first_time = 0.0;   ///< the source's clock, seconds
+    double first_time = 0.0;   ///< seconds, on the clock the times were given on
     double first_value = 0.0;  ///< as decoded, SI
   };
 
@@ -32,8 +32,6 @@ class DroppedSamples {
   static bool carriable(double value);
 
   bool keep(std::size_t channel, double time, double value);
-  std::uint64_t total() const;
-  const std::map<std::size_t, Channel>& by_channel() const { return by_channel_; }
   /// One line per channel: "channel 'vx': 1 sample left out (the first 2.5e+19, beyond the
   /// 1e+15 a chunk may carry, at 12.340 s of the bus's clock); ...". `where` names the clock the
   /// times are on ("the bus": auxiliary samples are put on the bus's clock before they enter).
