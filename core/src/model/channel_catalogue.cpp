@@ -7,38 +7,59 @@ namespace {
 
 constexpr const char* kCorners[] = {"fl", "fr", "rl", "rr"};
 
-std::vector<std::pair<std::string, std::string>> make_catalogue() {
-  std::vector<std::pair<std::string, std::string>> c{{"vx", "m/s"}, {"vy", "m/s"}};
-  for (const char* w : kCorners) c.emplace_back(std::string("wheel_speed_") + w, "m/s");
-  for (const char* n : {"ax", "ay", "az"}) c.emplace_back(n, "m/s^2");
-  for (const char* n : {"roll_rate", "pitch_rate", "yaw_rate"}) c.emplace_back(n, "rad/s");
-  c.insert(c.end(), {{"steer", "rad"},
-                     {"engine_speed", "rad/s"},
-                     {"engine_torque", "N m"},
-                     {"gearbox_input_speed", "rad/s"},
-                     {"gear", "-"},
-                     {"gear_ratio", "-"},
-                     {"clutch_clamp_load", "N"},
-                     {"wheel_torque", "N m"},
-                     {"brake_pressure", "Pa"},
-                     {"road_grade", "rad"},
-                     {"road_bank", "rad"},
-                     {"roll", "rad"}});
+struct Entry {
+  std::string name;
+  std::string unit;
+  ChannelPhysics physics;
+};
+
+// The ranges are impossibilities on a passenger car or light truck, wide on purpose (a value
+// outside is a decoding or sensor fault, never a hard manoeuvre): docs/CHANNELS.md has the table.
+std::vector<Entry> make_catalogue() {
+  constexpr double kSpeed = 120.0;        // m/s, 432 km/h
+  constexpr double kAcceleration = 50.0;  // m/s^2, 5 g
+  constexpr double kRate = 20.0;          // rad/s, a body spinning 3 turns a second
+  constexpr double kShaftSpeed = 1600.0;  // rad/s, 15 000 rpm
+  constexpr double kAngle = 1.5;          // rad, 86 degrees
+  constexpr double kForce = 1e5;          // N, ten tonnes on one corner
+  constexpr double kGravity = 9.80665;    // m/s^2: `az` at rest reads +g (specific force)
+  constexpr bool kMayHold = true;
+  std::vector<Entry> c{{"vx", "m/s", {-kSpeed, kSpeed}}, {"vy", "m/s", {-kSpeed, kSpeed}}};
+  for (const char* w : kCorners)
+    c.push_back({std::string("wheel_speed_") + w, "m/s", {-kSpeed, kSpeed}});
+  for (const char* n : {"ax", "ay"}) c.push_back({n, "m/s^2", {-kAcceleration, kAcceleration}});
+  c.push_back({"az", "m/s^2", {-kAcceleration, kAcceleration, kGravity}});
+  for (const char* n : {"roll_rate", "pitch_rate", "yaw_rate"})
+    c.push_back({n, "rad/s", {-kRate, kRate}});
+  c.insert(c.end(), {{"steer", "rad", {-kAngle, kAngle}},
+                     {"engine_speed", "rad/s", {-kShaftSpeed, kShaftSpeed}},
+                     {"engine_torque", "N m", {-5000.0, 5000.0}},
+                     {"gearbox_input_speed", "rad/s", {-kShaftSpeed, kShaftSpeed}},
+                     {"gear", "-", {-2.0, 20.0, 0.0, kMayHold}},
+                     {"gear_ratio", "-", {-100.0, 100.0, 0.0, kMayHold}},
+                     {"clutch_clamp_load", "N", {-kForce, kForce, 0.0, kMayHold}},
+                     {"wheel_torque", "N m", {-30000.0, 30000.0}},
+                     {"brake_pressure", "Pa", {-1e6, 5e7, 0.0, kMayHold}},
+                     {"road_grade", "rad", {-0.6, 0.6, 0.0, kMayHold}},
+                     {"road_bank", "rad", {-0.6, 0.6, 0.0, kMayHold}},
+                     {"roll", "rad", {-0.6, 0.6}}});
   for (const char* w : kCorners) {
-    c.emplace_back(std::string("susp_travel_") + w, "m");
-    c.emplace_back(std::string("susp_force_") + w, "N");
-    for (const char* f : {"hub_fx_", "hub_fy_", "hub_fz_"}) c.emplace_back(std::string(f) + w, "N");
-    for (const char* m : {"hub_mx_", "hub_my_", "hub_mz_"}) c.emplace_back(std::string(m) + w, "N m");
-    c.emplace_back(std::string("tyre_deflection_") + w, "m");
-    c.emplace_back(std::string("tyre_force_z_") + w, "N");
+    c.push_back({std::string("susp_travel_") + w, "m", {-0.5, 0.5}});
+    c.push_back({std::string("susp_force_") + w, "N", {-kForce, kForce}});
+    for (const char* f : {"hub_fx_", "hub_fy_", "hub_fz_"})
+      c.push_back({std::string(f) + w, "N", {-kForce, kForce}});
+    for (const char* m : {"hub_mx_", "hub_my_", "hub_mz_"})
+      c.push_back({std::string(m) + w, "N m", {-3e4, 3e4}});
+    c.push_back({std::string("tyre_deflection_") + w, "m", {-0.2, 0.2}});
+    c.push_back({std::string("tyre_force_z_") + w, "N", {-kForce, kForce}});
   }
   return c;
 }
 
-const std::map<std::string, std::string, std::less<>>& units() {
+const std::map<std::string, Entry, std::less<>>& entries() {
   static const auto table = [] {
-    std::map<std::string, std::string, std::less<>> t;
-    for (auto& [name, unit] : make_catalogue()) t.emplace(name, unit);
+    std::map<std::string, Entry, std::less<>> t;
+    for (auto& entry : make_catalogue()) t.emplace(entry.name, entry);
     return t;
   }();
   return table;
@@ -55,17 +76,23 @@ std::optional<std::string> per_second(const std::string& unit) {
 }  // namespace
 
 std::optional<std::string> channel_unit(std::string_view channel) {
-  if (auto it = units().find(channel); it != units().end()) return it->second;
+  if (auto it = entries().find(channel); it != entries().end()) return it->second.unit;
   if (channel.starts_with("d_")) {
-    if (auto it = units().find(channel.substr(2)); it != units().end()) return per_second(it->second);
+    if (auto it = entries().find(channel.substr(2)); it != entries().end())
+      return per_second(it->second.unit);
   }
+  return std::nullopt;
+}
+
+std::optional<ChannelPhysics> channel_physics(std::string_view channel) {
+  if (auto it = entries().find(channel); it != entries().end()) return it->second.physics;
   return std::nullopt;
 }
 
 const std::vector<std::string>& channel_names() {
   static const auto names = [] {
     std::vector<std::string> n;
-    for (auto& entry : make_catalogue()) n.push_back(entry.first);
+    for (auto& entry : make_catalogue()) n.push_back(entry.name);
     return n;
   }();
   return names;

@@ -5,7 +5,9 @@
 //
 // Contract: channel_unit() returns the unit of a catalogue channel, including the measured
 // derivative channels d_<name> (unit of <name> per second: "m/s" -> "m/s^2", "rad/s" ->
-// "rad/s^2", "m" -> "m/s"), and nullopt for any other name.
+// "rad/s^2", "m" -> "m/s"), and nullopt for any other name. channel_physics() returns the values a
+// base channel can physically take (docs/CHANNELS.md, "Physical ranges"): a sample outside is a
+// decoding or sensor fault, which the run's channel health reports (ingest/channel_health.hpp).
 #include <optional>
 #include <string>
 #include <string_view>
@@ -14,7 +16,18 @@
 namespace dynid::model {
 
 std::optional<std::string> channel_unit(std::string_view channel);
-/// Every base channel name (no d_ derivatives), in catalogue order.
+
+/// What a base channel can physically be (docs/CHANNELS.md, "Physical ranges").
+struct ChannelPhysics {
+  double lower = 0.0;  ///< the closed range [lower, upper], SI
+  double upper = 0.0;
+  /// The value a car at rest or driving straight on a flat road holds exactly (0; g for `az`).
+  double rest = 0.0;
+  /// A discrete state, a command or the road's geometry: it may hold any value for a whole run.
+  bool may_hold = false;
+};
+/// The physics of a base catalogue channel; nullopt for d_<name> and unknown names.
+std::optional<ChannelPhysics> channel_physics(std::string_view channel);
 const std::vector<std::string>& channel_names();
 
 }  // namespace dynid::model
