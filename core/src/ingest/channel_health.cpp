@@ -130,10 +130,10 @@ std::optional<ChannelFinding> out_of_range(const Series& s, const model::Channel
                             " " + where + ", reaching " + with_unit(extreme, s.unit)};
 }
 
-// Rule 3: the longest span held within the quantum, unless the channel may hold or holds its rest.
+// Rule 3: the longest span held within the quantum, on a channel that holds only at rest.
 std::optional<ChannelFinding> held(const Series& s, const model::ChannelPhysics& p,
                                    const HealthRules& rules) {
-  if (p.may_hold) return std::nullopt;
+  if (!p.holds_only_at_rest) return std::nullopt;
   const double q = quantum(s.value);
   // A thousandth of a quantum more: decoded levels (raw * factor + offset) differ by a quantum
   // only to rounding, and nothing moves by less than a quantum.

@@ -23,25 +23,27 @@ std::vector<Entry> make_catalogue() {
   constexpr double kAngle = 1.5;          // rad, 86 degrees
   constexpr double kForce = 1e5;          // N, ten tonnes on one corner
   constexpr double kGravity = 9.80665;    // m/s^2: `az` at rest reads +g (specific force)
-  constexpr bool kMayHold = true;
+  constexpr bool kRestOnly = true;
   std::vector<Entry> c{{"vx", "m/s", {-kSpeed, kSpeed}}, {"vy", "m/s", {-kSpeed, kSpeed}}};
   for (const char* w : kCorners)
     c.push_back({std::string("wheel_speed_") + w, "m/s", {-kSpeed, kSpeed}});
-  for (const char* n : {"ax", "ay"}) c.push_back({n, "m/s^2", {-kAcceleration, kAcceleration}});
-  c.push_back({"az", "m/s^2", {-kAcceleration, kAcceleration, kGravity}});
-  for (const char* n : {"roll_rate", "pitch_rate", "yaw_rate"})
-    c.push_back({n, "rad/s", {-kRate, kRate}});
+  c.push_back({"ax", "m/s^2", {-kAcceleration, kAcceleration, 0.0, kRestOnly}});
+  c.push_back({"ay", "m/s^2", {-kAcceleration, kAcceleration}});
+  c.push_back({"az", "m/s^2", {-kAcceleration, kAcceleration, kGravity, kRestOnly}});
+  for (const char* n : {"roll_rate", "pitch_rate"})
+    c.push_back({n, "rad/s", {-kRate, kRate, 0.0, kRestOnly}});
+  c.push_back({"yaw_rate", "rad/s", {-kRate, kRate}});
   c.insert(c.end(), {{"steer", "rad", {-kAngle, kAngle}},
                      {"engine_speed", "rad/s", {-kShaftSpeed, kShaftSpeed}},
                      {"engine_torque", "N m", {-5000.0, 5000.0}},
                      {"gearbox_input_speed", "rad/s", {-kShaftSpeed, kShaftSpeed}},
-                     {"gear", "-", {-2.0, 20.0, 0.0, kMayHold}},
-                     {"gear_ratio", "-", {-100.0, 100.0, 0.0, kMayHold}},
-                     {"clutch_clamp_load", "N", {-kForce, kForce, 0.0, kMayHold}},
+                     {"gear", "-", {-2.0, 20.0}},
+                     {"gear_ratio", "-", {-100.0, 100.0}},
+                     {"clutch_clamp_load", "N", {-kForce, kForce}},
                      {"wheel_torque", "N m", {-30000.0, 30000.0}},
-                     {"brake_pressure", "Pa", {-1e6, 5e7, 0.0, kMayHold}},
-                     {"road_grade", "rad", {-0.6, 0.6, 0.0, kMayHold}},
-                     {"road_bank", "rad", {-0.6, 0.6, 0.0, kMayHold}},
+                     {"brake_pressure", "Pa", {-1e6, 5e7}},
+                     {"road_grade", "rad", {-0.6, 0.6}},
+                     {"road_bank", "rad", {-0.6, 0.6}},
                      {"roll", "rad", {-0.6, 0.6}}});
   for (const char* w : kCorners) {
     c.push_back({std::string("susp_travel_") + w, "m", {-0.5, 0.5}});

@@ -15,10 +15,12 @@
 //    the channel's quantum (the smallest non-zero step between consecutive valid samples seen
 //    anywhere in the run, 0 for a channel that never changes: a sensor cannot resolve less, so
 //    a span within it carries no change at all) lasts at least `min_span_s` seconds and holds
-//    at least `min_share` of the channel's valid samples. A channel the catalogue says may hold
-//    (model::channel_may_hold: discrete states, commands, the road's geometry) is not judged on
-//    this rule, and neither is a span held at the channel's rest value (0, or g for `az`),
-//    which a car standing or driving straight holds exactly on a noise-free record.
+//    at least `min_share` of the channel's valid samples, on a channel that a car holds only at
+//    its rest value (model::ChannelPhysics::holds_only_at_rest: `ax`, `az`, the roll and pitch
+//    rates), at a value more than a quantum (or a thousandth of its range) from that rest. Other
+//    channels hold exactly in any steady state on a quantised noise-free record (a cruise's
+//    speed, steady cornering's yaw rate and steer, a static load, idle), so a held span of
+//    theirs is not a fault; their stuck sensors are not found by this rule.
 // 4. Invalid share: when at least `max_invalid_share` of the run's samples are invalid, one
 //    run-wide finding (validity is per grid row: the car knows which signal was missing, the run
 //    does not). It is reported, but blocks no model: the valid rows still identify.

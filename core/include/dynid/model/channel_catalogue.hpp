@@ -23,8 +23,11 @@ struct ChannelPhysics {
   double upper = 0.0;
   /// The value a car at rest or driving straight on a flat road holds exactly (0; g for `az`).
   double rest = 0.0;
-  /// A discrete state, a command or the road's geometry: it may hold any value for a whole run.
-  bool may_hold = false;
+  /// True where every steady state of a car (standing, a cruise, steady cornering) puts the
+  /// channel at its rest value: `ax` (but on a grade), `az`, the roll and pitch rates. Held
+  /// anywhere else, such a channel is stuck. Every other channel holds some value in a steady
+  /// state (a speed, a steer, a static load, idle), so a held span is no fault of its own.
+  bool holds_only_at_rest = false;
 };
 /// The physics of a base catalogue channel; nullopt for d_<name> and unknown names.
 std::optional<ChannelPhysics> channel_physics(std::string_view channel);
