@@ -28,14 +28,19 @@ std::string parameter_line(const dds::ParameterEntry& p) {
   return line + "\n";
 }
 
-std::string parameter_json(const dds::ParameterEntry& p) {
+// On a table whose model reads an unhealthy channel every row is "not identified" with the
+// table's reason: its value is a number, not an estimate.
+std::string parameter_json(const dds::ParameterEntry& p, const std::string& not_identified) {
+  const bool judged = not_identified.empty();
   return fmt::format(
       "{{\"name\":{},\"unit\":{},\"value\":{},\"std\":{},\"relative_std_percent\":{},"
-      "\"status\":{},\"relation\":{},\"reason\":{},\"least_squares_value\":{},\"least_squares_std\":{}}}",
+      "\"status\":{},\"relation\":{},\"reason\":{},\"least_squares_value\":{},\"least_squares_"
+      "std\":{}}}",
       json_string(p.name), json_string(p.unit), json_number(p.value),
       json_number(p.standard_deviation), json_number(p.relative_std_percent),
-      json_string(status_name(p.status)), json_string(p.relation), json_string(p.reason),
-      json_number(p.least_squares_value), json_number(p.least_squares_std));
+      json_string(judged ? status_name(p.status) : "not identified"), json_string(p.relation),
+      json_string(judged ? p.reason : not_identified), json_number(p.least_squares_value),
+      json_number(p.least_squares_std));
 }
 
 }  // namespace
@@ -58,7 +63,11 @@ std::string format_estimate_text(const dds::EstimateTable& t) {
   std::string out = t.revision == 0
                         ? fmt::format("{} / {}  (source {}, not published)\n", t.vehicle, t.model, t.source)
                         : fmt::format("{} / {}  (source {}, revision {})\n", t.vehicle, t.model, t.source, t.revision);
-  // A model the run does not excite: one line, no numbers that would read as estimates.
+  // A model read from an unhealthy channel, or one the run does not excite: one line, no
+  // numbers that would read as estimates.
+  if (!t.not_identified.empty())
+    return out + fmt::format("  not identified: {} ({} rows; --json has the numbers)\n",
+                             t.not_identified, t.rows);
   if (!t.not_excited.empty())
     return out + fmt::format("  not excited by this run: {} ({} rows; --json has the numbers)\n",
                              t.not_excited, t.rows);
@@ -84,7 +93,8 @@ std::string format_estimate_text(const dds::EstimateTable& t) {
 
 std::string estimate_json(const dds::EstimateTable& t) {
   std::string parameters;
-  for (const auto& p : t.parameters) parameters += (parameters.empty() ? "" : ",") + parameter_json(p);
+  for (const auto& p : t.parameters)
+    parameters += (parameters.empty() ? "" : ",") + parameter_json(p, t.not_identified);
   std::string groups;
   for (const auto& g : t.groups)
     groups += (groups.empty() ? "" : ",") +
@@ -93,15 +103,16 @@ std::string estimate_json(const dds::EstimateTable& t) {
   return fmt::format(
       "{{\"vehicle\":{},\"model\":{},\"source\":{},\"revision\":{},\"parameters\":[{}],"
       "\"rows\":{},\"effective_rows\":{},\"sigma\":{},\"condition_number\":{},"
-      "\"residual_rms\":{},\"relative_residual_norm\":{},\"groups\":[{}],\"not_excited\":{},"
+      "\"residual_rms\":{},\"relative_residual_norm\":{},\"groups\":[{}],\"not_excited\":{},\"not_"
+      "identified\":{},"
       "\"residual_verdict\":{},\"residual_statement\":{},\"residual_through\":{},"
       "\"estimator\":{},\"bias_test\":{},\"bias_through\":{}}}",
       json_string(t.vehicle), json_string(t.model), json_string(t.source), t.revision, parameters,
-      t.rows, json_number(t.effective_rows), json_number(t.sigma),
-      json_number(t.condition_number), json_number(t.residual_rms),
-      json_number(t.relative_residual_norm), groups, json_string(t.not_excited),
-      json_string(t.residual_verdict), json_string(t.residual_statement), t.residual_through,
-      json_string(t.estimator), json_string(t.bias_test), t.bias_through);
+      t.rows, json_number(t.effective_rows), json_number(t.sigma), json_number(t.condition_number),
+      json_number(t.residual_rms), json_number(t.relative_residual_norm), groups,
+      json_string(t.not_excited), json_string(t.not_identified), json_string(t.residual_verdict),
+      json_string(t.residual_statement), t.residual_through, json_string(t.estimator),
+      json_string(t.bias_test), t.bias_through);
 }
 
 std::string estimates_json(const std::vector<dds::EstimateTable>& tables) {

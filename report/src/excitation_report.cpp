@@ -29,6 +29,9 @@ ManoeuvreNeed& need_for(std::vector<ManoeuvreNeed>& needs, const std::string& ex
 // The lines of one model: what it identifies, then each kind of what it cannot, with why.
 std::string model_text(const ModelExcitation& m) {
   const dds::EstimateTable& t = m.table;
+  // Read from an unhealthy channel: a manoeuvre cannot help, and nothing it says is a result.
+  if (!t.not_identified.empty())
+    return fmt::format("  {}: not identified: {}\n", t.model, t.not_identified);
   std::vector<std::string> identified, poor, not_excited, implausible, structure;
   for (std::size_t j = 0; j < t.parameters.size(); ++j) {
     const dds::ParameterEntry& p = t.parameters[j];
@@ -71,8 +74,10 @@ std::string model_json(const ModelExcitation& m) {
                               json_number(p.relative_std_percent), json_string(p.reason),
                               json_string(j < m.excited_by.size() ? m.excited_by[j] : ""));
   }
-  return fmt::format("{{\"model\":{},\"not_excited\":{},\"parameters\":[{}]}}", json_string(m.table.model),
-                     json_string(m.table.not_excited), parameters);
+  return fmt::format(
+      "{{\"model\":{},\"not_excited\":{},\"not_identified\":{},\"parameters\":[{}]}}",
+      json_string(m.table.model), json_string(m.table.not_excited),
+      json_string(m.table.not_identified), parameters);
 }
 
 }  // namespace
@@ -80,7 +85,9 @@ std::string model_json(const ModelExcitation& m) {
 std::vector<ManoeuvreNeed> manoeuvre_needs(const ExcitationReport& report) {
   std::vector<ManoeuvreNeed> needs;
   for (const ModelExcitation& m : report.models)
-    for (std::size_t j = 0; j < m.table.parameters.size() && j < m.excited_by.size(); ++j) {
+    for (std::size_t j = 0;
+         m.table.not_identified.empty() && j < m.table.parameters.size() && j < m.excited_by.size();
+         ++j) {
       const dds::ParameterEntry& p = m.table.parameters[j];
       if (m.excited_by[j].empty()) continue;
       const std::string name = m.table.model + "." + p.name;

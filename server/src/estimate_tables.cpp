@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "dynid/model/registry.hpp"
 #include "dynid/report/estimate_report.hpp"
 #include "dynid/report/json.hpp"
 #include "dynid/residual/publication.hpp"
@@ -98,10 +99,33 @@ EstimateTables tables_of(const std::string& vehicle, const std::string& source,
   return out;
 }
 
+void apply_health(EstimateTables& tables, const ingest::RunHealth& health,
+                  const ingest::RunAnnouncement& announcement) {
+  for (const ingest::ChannelFinding& f : health.findings)
+    tables.notes.push_back("channel health: " + f.statement);
+  for (dds::EstimateTable& table : tables.tables) {
+    const auto spec =
+        std::find_if(announcement.models.begin(), announcement.models.end(),
+                     [&](const ingest::ModelSpec& m) { return m.model == table.model; });
+    if (spec == announcement.models.end()) continue;  // a pool's or a reprocessing's own spec
+    const auto model = model::make_model(spec->model, spec->constants);
+    const auto reason = ingest::unhealthy_reason(health, announcement, *model, spec->effects);
+    if (!reason) continue;
+    table.not_identified = *reason;
+    table.not_excited.clear();
+    table.residual_verdict.clear();
+    table.residual_statement.clear();
+    table.bias_test.clear();
+  }
+}
+
 report::ExcitationReport excitation_of(const std::string& vehicle, const std::string& run,
-                                       const std::vector<ingest::ModelEstimate>& estimates) {
+                                       const std::vector<ingest::ModelEstimate>& estimates,
+                                       const ingest::RunHealth& health,
+                                       const ingest::RunAnnouncement& announcement) {
   report::ExcitationReport out{vehicle, run, {}, {}};
-  const EstimateTables tables = tables_of(vehicle, run, estimates);
+  EstimateTables tables = tables_of(vehicle, run, estimates);
+  apply_health(tables, health, announcement);
   out.notes = tables.notes;
   for (const dds::EstimateTable& table : tables.tables) {
     const auto e = std::find_if(estimates.begin(), estimates.end(),

@@ -6,9 +6,11 @@
 #include <set>
 
 #include "dynid/error.hpp"
+#include "dynid/ingest/channel_health.hpp"
 #include "dynid/ingest/recorded_run.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/report/iv_report.hpp"
+#include "dynid/report/json.hpp"
 #include "dynid/report/residual_html.hpp"
 #include "dynid/report/residual_report.hpp"
 #include "dynid/report/simex_report.hpp"
@@ -94,15 +96,52 @@ ResidualReply trace_reply(const residual::Trace& t, const std::string& title,
   return {report::format_trace_text(t), "text/plain"};
 }
 
+std::string escape_html(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else
+      out += c;
+  }
+  return out;
+}
+
+// The reply for a model read from an unhealthy channel: one line in place of any judgement.
+ResidualReply not_identified_reply(const std::string& title, const std::string& model,
+                                   const std::string& reason, const std::string& format) {
+  const std::string line = ingest::not_identified(reason);
+  if (format == "json")
+    return {"{\"model\":" + report::json_string(model) +
+                ",\"not_identified\":" + report::json_string(reason) + "}",
+            "application/json"};
+  if (format == "html")
+    return {"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>" + escape_html(title) +
+                "</title></head><body><p>" + escape_html(title + ": " + line) +
+                "</p></body></html>\n",
+            "text/html"};
+  return {title + ": " + line + "\n", "text/plain"};
+}
+
 // Every announced model with its declared effects; a model the run cannot fit (no row: a
-// manoeuvre that never meets its masks) is left out and named.
-ResidualReply consistency_reply(const ingest::RunAnnouncement& announcement, const std::vector<ingest::PreprocessedSegment>& segments,
-                                const ResidualRequest& request) {
+// manoeuvre that never meets its masks) or reads from an unhealthy channel is left out and named.
+ResidualReply consistency_reply(const ingest::RunAnnouncement& announcement,
+                                const std::vector<ingest::PreprocessedSegment>& segments,
+                                const ingest::RunHealth& health, const ResidualRequest& request) {
   std::vector<residual::ModelParameters> fits;
   std::vector<std::string> left_out;
   for (const ingest::ModelSpec& spec : announcement.models) {
     try {
       const auto model = model::make_model(spec.model, spec.constants);
+      if (const auto reason =
+              ingest::unhealthy_reason(health, announcement, *model, spec.effects)) {
+        left_out.push_back(spec.model + ": " + ingest::not_identified(*reason));
+        continue;
+      }
       fits.push_back(residual::hac_parameters(*model, spec.effects, segments, announcement.sample_rate_hz,
                                               announcement.preprocessing.odmf));
     } catch (const InputError& e) {
@@ -159,12 +198,18 @@ ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
   const auto segments = ingest::preprocess_offline(run);
   if (segments.empty())
     throw InputError("run " + announcement.vehicle + "/" + announcement.run + ": no valid segment long enough to filter");
-  if (consistency) return consistency_reply(announcement, segments, request);
+  const ingest::RunHealth health = ingest::channel_health(run);
+  if (consistency) return consistency_reply(announcement, segments, health, request);
   const std::vector<std::string> declared = request.effects.value_or(spec->effects);
   const model::Model& model = *models.front();
   const double rate = announcement.sample_rate_hz;
   const int odmf = announcement.preprocessing.odmf;
   const std::string title = announcement.vehicle + " / " + announcement.run + " / " + spec->model;
+  // The effects compared or screened read channels too: the candidate's as well as the declared.
+  std::vector<std::string> read = declared;
+  if (!request.effect.empty()) read.push_back(request.effect);
+  if (const auto reason = ingest::unhealthy_reason(health, announcement, model, read))
+    return not_identified_reply(title, spec->model, *reason, request.format);
   if (request.kind == "iv") {
     const residual::IvFit fit = iv_of(model, declared, announcement, segments);
     if (request.format == "json") return {report::iv_json(fit), "application/json"};
@@ -231,6 +276,7 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
   residual::DiagnosisOptions options;
   options.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
   std::optional<std::vector<residual::ChannelNoise>> noise;  // measured once, when a model needs it
+  const ingest::RunHealth health = ingest::channel_health(run);
   for (const ingest::ModelSpec& spec : announcement.models) {
     if (std::find(models.begin(), models.end(), spec.model) == models.end()) continue;
     LiveVerdict verdict;
@@ -240,6 +286,8 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
     } catch (const InputError&) {
       continue;  // the server folds no such model either
     }
+    // No verdict on a model read from an unhealthy channel: "adequate" would read as a result.
+    if (ingest::unhealthy_reason(health, announcement, *model, spec.effects)) continue;
     try {
       const residual::Diagnosis d = residual::diagnose(*model, spec.effects, run, segments, options);
       const bool measured = std::all_of(d.floor.groups.begin(), d.floor.groups.end(),

@@ -99,6 +99,7 @@ EstimateTables RunService::estimate(const std::string& vehicle,
   stamp_revisions(state, tables);
   if (model && tables.tables.empty() && tables.notes.empty())
     throw NotFound("run " + vehicle + "/" + key.run + " has no model " + *model);
+  apply_health(tables, run_health(key, state), state.processor.announcement());
   if (!state.halted.empty()) tables.notes.push_back(key.run + ": " + state.halted);
   return tables;
 }
@@ -106,8 +107,10 @@ EstimateTables RunService::estimate(const std::string& vehicle,
 report::ExcitationReport RunService::excitation(const std::string& vehicle, const std::optional<std::string>& run) {
   settle();  // the chunks received before this request count, the ledger up to date
   const store::RunKey key{vehicle, run ? *run : latest_run(vehicle)};
-  const RunState& state = load(key);
-  report::ExcitationReport out = excitation_of(vehicle, key.run, state.processor.estimates());
+  RunState& state = load(key);
+  report::ExcitationReport out =
+      excitation_of(vehicle, key.run, state.processor.estimates(), run_health(key, state),
+                    state.processor.announcement());
   if (!state.halted.empty()) out.notes.push_back(key.run + ": " + state.halted);
   return out;
 }
@@ -179,6 +182,7 @@ EstimateTables RunService::close(const std::string& vehicle, const std::string& 
   const auto estimates = state.processor.estimates();
   auto tables = tables_of(vehicle, run, estimates);
   attach_live(state, estimates, tables);
+  apply_health(tables, run_health(key, state), state.processor.announcement());
   stamp_revisions(state, tables);
   record_history(key, tables);
   spdlog::info("run {}/{}: closed", vehicle, run);
@@ -212,6 +216,16 @@ void RunService::replay_stored(const store::RunKey& key, const RunState& state,
     for (const auto& chunk : read_chunks(key, next, to)) sink(chunk);
     next = to + 1;
   }
+}
+
+const ingest::RunHealth& RunService::run_health(const store::RunKey& key, RunState& state) {
+  if (state.contiguous < 0 || state.health_through == state.contiguous) return state.health;
+  std::vector<ingest::Chunk> chunks;
+  replay_stored(key, state, [&](const ingest::Chunk& chunk) { chunks.push_back(chunk); });
+  state.health =
+      ingest::channel_health(ingest::assemble_run(state.processor.announcement(), chunks));
+  state.health_through = state.contiguous;
+  return state.health;
 }
 
 ResidualReply RunService::residual(const std::string& vehicle, const std::string& run,

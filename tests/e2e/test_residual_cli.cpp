@@ -256,6 +256,86 @@ TEST(E2eResidualCli, TheLiveVerdictIsPublishedBesideTheEstimates) {
     EXPECT_NE(table["estimator"], "instrumental variables") << bias_test;
 }
 
+// A stuck accelerometer (`ax` constant at -0.57 m/s^2 for the whole run) through the server and
+// the CLI: the model that reads it gets one line from every command and no verdict, live or on
+// the topic; the models that do not read it are judged as before.
+TEST(E2eResidualCli, AModelReadingAStuckChannelIsJudgedByNoCommand) {
+  TempDir dir;
+  server::ServerOptions options = server_options(dir.file("store.db"));
+  options.live_residual_interval = std::chrono::seconds(1);
+  InProcessServer server(options);
+  auto run = test_run("stuck-car", "run-s", 46u);
+  const auto ax = static_cast<Eigen::Index>(run.announcement.column_of("ax"));
+  for (Eigen::Index i = 0; i < run.samples.rows(); ++i)
+    if (run.valid[static_cast<std::size_t>(i)] != 0) run.samples(i, ax) = -0.57;
+  const auto chunks = cut_run(run, 7u);
+  EstimateWatcher watcher("stuck-car");
+  TestCar car("stuck-car");
+  ASSERT_TRUE(car.stream(run.announcement, chunks));
+  ASSERT_EQ(dynid({"close", "--vehicle", "stuck-car", "--run", "run-s"}).exit_code, 0);
+  const std::vector<std::string> where{"--vehicle", "stuck-car", "--run", "run-s"};
+  const auto with = [&](std::vector<std::string> args, const std::vector<std::string>& more = {}) {
+    args.insert(args.end(), where.begin(), where.end());
+    args.insert(args.end(), more.begin(), more.end());
+    return dynid(args);
+  };
+  // The live job has judged the run once the healthy model's verdict includes the last chunk.
+  nlohmann::json tables;
+  for (int attempt = 0; attempt < 120; ++attempt) {
+    const auto reply = with({"--json", "estimates"});
+    ASSERT_EQ(reply.exit_code, 0) << reply.err;
+    tables = nlohmann::json::parse(reply.out);
+    bool judged = false;
+    for (const auto& t : tables["tables"])
+      judged |= t["model"] == "longitudinal_wheel" &&
+                t["residual_through"] == chunks.back().sequence &&
+                !t["residual_verdict"].get<std::string>().empty();
+    if (judged) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+  const std::string stuck = "`ax` is constant at -0.57 m/s^2";
+  for (const auto& t : tables["tables"]) {
+    const std::string reason = t["not_identified"];
+    if (t["model"] != "kinematic_longitudinal") {
+      EXPECT_EQ(reason, "") << t.dump();
+      continue;
+    }
+    EXPECT_EQ(reason.find(stuck), 0u) << t.dump();
+    EXPECT_EQ(t["residual_verdict"], "") << t.dump();
+    EXPECT_EQ(t["bias_test"], "") << t.dump();
+    for (const auto& p : t["parameters"]) EXPECT_EQ(p["status"], "not identified") << p.dump();
+  }
+  const auto text = with({"estimates"}, {"--model", "kinematic_longitudinal"});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("  not identified: " + stuck), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("poorly"), std::string::npos) << text.out;
+  const auto excitation = with({"excitation"});
+  ASSERT_EQ(excitation.exit_code, 0) << excitation.err;
+  EXPECT_NE(excitation.out.find("kinematic_longitudinal: not identified: " + stuck),
+            std::string::npos)
+      << excitation.out;
+  EXPECT_EQ(excitation.out.find("kinematic_longitudinal."), std::string::npos) << excitation.out;
+  for (const char* kind : {"trace", "residual"}) {
+    const auto reply = with({kind}, {"--model", "kinematic_longitudinal"});
+    ASSERT_EQ(reply.exit_code, 0) << reply.err;
+    EXPECT_NE(reply.out.find("kinematic_longitudinal: not identified: " + stuck), std::string::npos)
+        << reply.out;
+    EXPECT_EQ(reply.out.find("adequate"), std::string::npos) << reply.out;
+  }
+  const auto consistency = with({"--json", "consistency"});
+  ASSERT_EQ(consistency.exit_code, 0) << consistency.err;
+  EXPECT_NE(nlohmann::json::parse(consistency.out)["left_out"].dump().find(
+                "kinematic_longitudinal: not identified: " + stuck),
+            std::string::npos)
+      << consistency.out;
+  // On the topic, which does not carry the health: at least no verdict.
+  watcher.wait_for({}, "run-s", std::chrono::milliseconds(2000));
+  const auto& published = watcher.latest("run-s");
+  const auto it = published.find("kinematic_longitudinal");
+  ASSERT_NE(it, published.end()) << watcher.seen();
+  EXPECT_EQ(it->second.residual_verdict, "");
+}
+
 // Issue 16 item 2: a run whose speed sensor is noisy biases least squares (the differentiated
 // speed is a regressor). The live bias test (Durbin-Wu-Hausman) rejects it, and the tables carry
 // the instrumental-variable values with their HAC std, the least-squares ones beside them: the

@@ -75,6 +75,8 @@ nlohmann::json estimate_json(const wire::Estimate& e) {
           {"relative_residual_norm", number(e.relative_residual_norm())},
           {"groups", groups},
           {"not_excited", e.not_excited().to_string()},
+          // Not on the wire: the server's replies alone say why a model's channel cannot be judged.
+          {"not_identified", ""},
           {"residual_verdict", e.residual_verdict().to_string()},
           {"residual_statement", e.residual_statement().to_string()},
           {"residual_through", e.residual_through()},

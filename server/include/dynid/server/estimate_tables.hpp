@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "dynid/dds/estimate_table.hpp"
+#include "dynid/ingest/channel_health.hpp"
 #include "dynid/ingest/run_processor.hpp"
 #include "dynid/report/excitation_report.hpp"
 #include "dynid/residual/iv_fit.hpp"
@@ -46,10 +47,20 @@ EstimateTables tables_of(const std::string& vehicle, const std::string& source,
                          const std::vector<ingest::ModelEstimate>& estimates,
                          const std::optional<std::string>& model = std::nullopt);
 
+/// Every table whose model reads a channel that is unhealthy on the run (ingest::unhealthy_reason,
+/// with the announcement's spec of the model) gets `not_identified` and loses what would judge
+/// it: the not-excited advice, the residual verdict and the bias test. Every finding of the run
+/// is added to the notes ("channel health: <statement>").
+void apply_health(EstimateTables& tables, const ingest::RunHealth& health,
+                  const ingest::RunAnnouncement& announcement);
+
 /// The run's excitation report (report/excitation_report.hpp): its tables as tables_of() makes
-/// them, each parameter with the signal that excites it (model::ParameterInfo::excited_by).
+/// them with apply_health(), each parameter with the signal that excites it
+/// (model::ParameterInfo::excited_by).
 report::ExcitationReport excitation_of(const std::string& vehicle, const std::string& run,
-                                       const std::vector<ingest::ModelEstimate>& estimates);
+                                       const std::vector<ingest::ModelEstimate>& estimates,
+                                       const ingest::RunHealth& health,
+                                       const ingest::RunAnnouncement& announcement);
 
 /// Text (the tables, then the notes) or JSON ({"tables":[...],"notes":[...]}).
 std::string render(const EstimateTables& tables, bool json);

@@ -191,6 +191,9 @@ class RunService {
     // The first verdict waits an interval from the run's load (or its close): a few chunks carry
     // too little to measure a noise floor on.
     std::chrono::steady_clock::time_point residual_at = std::chrono::steady_clock::now();
+    // The channel health of the stored chunks through `health_through` (run_health()).
+    ingest::RunHealth health;
+    std::int64_t health_through = -1;
   };
   struct PendingChunk {
     store::RunKey key;
@@ -243,6 +246,9 @@ class RunService {
   /// Every stored chunk of the run up to the highest contiguous one, in order, to `sink`.
   void replay_stored(const store::RunKey& key, const RunState& run,
                      const std::function<void(const ingest::Chunk&)>& sink);
+  /// The channel health of the run's stored chunks (ingest/channel_health.hpp), computed again
+  /// only when chunks joined since: a reply's tables then say which models cannot be judged.
+  const ingest::RunHealth& run_health(const store::RunKey& key, RunState& run);
   void take_checkpoint(const store::RunKey& key, RunState& run);
   void save_folds(const std::vector<store::RunKey>& keys);
   std::vector<SavedFold> take_unsaved(const std::vector<store::RunKey>& keys);

@@ -65,6 +65,10 @@ struct EstimateTable {
   std::vector<GroupResidual> groups;
   /// "" unless the source excites none of the parameters; then what would ("needs d_vx (...)").
   std::string not_excited = {};
+  /// "" unless a channel the model reads is unhealthy on the run (ingest/channel_health.hpp);
+  /// then why, one line. The rows stay (JSON) but no status, verdict or advice is given. Set by
+  /// the server's replies; not carried on the Estimate topic.
+  std::string not_identified = {};
   /// The residual loop's verdict on the run so far (residual/diagnosis.hpp), kept current by a
   /// server started with a live-residual interval: "adequate", "explained" or "structure left";
   /// "" when not computed (off, a pool, no row yet). The statement says why (cut to the wire's
