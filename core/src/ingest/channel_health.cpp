@@ -193,8 +193,9 @@ std::string source_channel(const RunAnnouncement& announcement, const std::strin
 std::set<std::string> read_channels(const RunAnnouncement& announcement, const model::Model& model,
                                     const std::vector<std::string>& effects) {
   std::set<std::string> out;
+  // Optional channels serve effects (ChannelNeed::optional): read only when an effect is on.
   for (const model::ChannelNeed& need : model.channels())
-    out.insert(source_channel(announcement, need.name));
+    if (!need.optional) out.insert(source_channel(announcement, need.name));
   for (const model::Effect& e : model.candidate_effects())
     if (std::find(effects.begin(), effects.end(), e.name) != effects.end())
       for (const std::string& c : e.channels) out.insert(source_channel(announcement, c));

@@ -6,7 +6,7 @@
 // while the data hold no information; the health findings say so in one line instead.
 //
 // Rules, per announced channel, over its valid samples (RecordedRun::valid), in this order:
-// 1. Sentinel: the samples outside the channel's physical range (model::channel_range) are, for
+// 1. Sentinel: the samples outside the channel's physical range (model::channel_physics) are, for
 //    at least `sentinel_share` of them, one exact value: an invalid marker (a DBC's all-ones
 //    raw value, an ECU's "not available"), not a measurement. Otherwise
 // 2. Out of range: any valid sample outside the physical range. The ranges are impossibilities
@@ -30,9 +30,9 @@
 // from 3.1 s to 36 s (92 % of its valid samples)".
 //
 // unhealthy_reason() is the one decision every reply takes: "may this model be judged on this
-// run?". It returns the first blocking finding of any channel the model reads (its channels,
-// optional ones the run carries, the channels of its enabled effects; d_<name> stands for <name>
-// when the run does not measure the derivative itself), nullopt when there is none.
+// run?". It returns the first blocking finding of any channel the model reads (its required
+// channels and those of its enabled effects: an optional channel serves an effect; d_<name>
+// stands for <name> when the run does not measure the derivative itself), nullopt when none.
 #include <optional>
 #include <string>
 #include <vector>
