@@ -103,8 +103,7 @@ ResidualReply consistency_reply(const ingest::RunAnnouncement& announcement, con
   for (const ingest::ModelSpec& spec : announcement.models) {
     try {
       const auto model = model::make_model(spec.model, spec.constants);
-      fits.push_back(residual::hac_parameters(*model, spec.effects, segments, announcement.sample_rate_hz,
-                                              announcement.preprocessing.odmf));
+      fits.push_back(residual::compared_parameters(*model, spec.effects, segments, announcement));
     } catch (const InputError& e) {
       left_out.push_back(spec.model + ": " + e.what());
     }
