@@ -222,7 +222,8 @@ residual::SimexFit simex_of(const model::Model& model, const std::vector<std::st
 
 std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& announcement,
                                                  const std::vector<ingest::Chunk>& chunks,
-                                                 const std::vector<std::string>& models) {
+                                                 const std::vector<std::string>& models,
+                                                 bool diagnose) {
   std::map<std::string, LiveVerdict> out;
   const ingest::RecordedRun run = ingest::assemble_run(announcement, chunks);
   const auto segments = ingest::preprocess_offline(run);
@@ -240,10 +241,15 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
       continue;  // the server folds no such model either
     }
     try {
-      const residual::Diagnosis d = residual::diagnose(*model, spec.effects, run, segments, options);
-      const bool measured = std::all_of(d.floor.groups.begin(), d.floor.groups.end(),
-                                        [](const residual::GroupFloor& g) { return g.rows == 0 || g.floor_rms > 0.0; });
-      if (measured) verdict.verdict = residual::verdict_name(d.verdict), verdict.statement = d.statement();
+      if (diagnose) {
+        const residual::Diagnosis d =
+            residual::diagnose(*model, spec.effects, run, segments, options);
+        const bool measured = std::all_of(
+            d.floor.groups.begin(), d.floor.groups.end(),
+            [](const residual::GroupFloor& g) { return g.rows == 0 || g.floor_rms > 0.0; });
+        if (measured)
+          verdict.verdict = residual::verdict_name(d.verdict), verdict.statement = d.statement();
+      }
     } catch (const InputError&) {
       // Not diagnosable yet (no row of this model so far): no verdict rather than a wrong one.
     }
