@@ -186,6 +186,49 @@ TEST(HostileCar, AFileThatIsNoCanLogFailsNamingItAndWritesNothing) {
   }
 }
 
+// A line of megabytes of junk in a good log is one bad line: skipped to its end, every frame
+// delivered. It once counted as one bad line per KiB and outvoted the frames around it ("most
+// lines or objects are not CAN frames", exit 1); here 8192 pieces against 6000 frames would.
+TEST(HostileCar, AJunkLineOfMegabytesIsOneBadLineAndEveryFrameIsDelivered) {
+  ScratchDir scratch("hostile-long-line");
+  const std::vector<can::Frame> all = at_epoch(simulated_frames());
+  const std::vector<can::Frame> frames(all.begin(), all.begin() + 6000);
+  std::ostringstream good;
+  std::ostringstream junked;
+  {
+    can::CandumpWriter plain(good);
+    can::CandumpWriter with_junk(junked);
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      if (i == 3000) junked << std::string(8u << 20, 'x') << "\n";
+      plain.write(frames[i]);
+      with_junk.write(frames[i]);
+    }
+  }
+  const auto chunks_of = [&](const std::string& name, const std::string& text) {
+    const auto log = scratch.path() / (name + ".log");
+    const auto out = scratch.path() / (name + ".chunks");
+    write_text(log, text);
+    const Outcome o = run(Program::Car,
+                          {"--profile", testcar_profile().string(), "--run", "r1", "--replay",
+                           log.string(), "--fast", "--chunks-out", out.string()},
+                          scratch, 20s);
+    return std::make_pair(o, std::filesystem::exists(out) ? read_text(out) : std::string());
+  };
+  const auto [plain_run, plain_chunks] = chunks_of("plain", good.str());
+  ASSERT_EQ(plain_run.exit, 0) << describe(plain_run);
+  const auto [junk_run, junk_chunks] = chunks_of("junk", junked.str());
+  ASSERT_EQ(junk_run.exit, 0) << describe(junk_run);
+  EXPECT_NE(junk_run.output.find("6000 frames (1 bad lines"), std::string::npos)
+      << describe(junk_run);
+  EXPECT_NE(junk_run.output.find(
+                "junk.log:3001: line of 8388608 bytes, longer than the 1024 a line may have"),
+            std::string::npos)
+      << describe(junk_run);
+  EXPECT_FALSE(plain_chunks.empty());
+  EXPECT_TRUE(junk_chunks == plain_chunks) << "the junk line changes no chunk";
+  EXPECT_LT(junk_run.seconds, 5.0) << describe(junk_run);
+}
+
 // Case 4 of issue 19: a FIFO as the DBC, profile or log blocked dynid-car for ever. Every input
 // that is not a regular file is refused at once, naming it and what it is.
 TEST(HostileCar, InputsThatAreNotRegularFilesAreRefusedAtOnce) {
