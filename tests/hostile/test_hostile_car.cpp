@@ -5,6 +5,7 @@
 // bounded time (every child runs under a time limit), and nothing written (no chunk file).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -12,6 +13,7 @@
 
 #include <dynid/can/candump.hpp>
 #include <dynid/car/chunk_file.hpp>
+#include <dynid/car/vehicle_profile.hpp>
 
 #include "hostile_support.hpp"
 
@@ -227,6 +229,81 @@ TEST(HostileCar, AJunkLineOfMegabytesIsOneBadLineAndEveryFrameIsDelivered) {
   EXPECT_FALSE(plain_chunks.empty());
   EXPECT_TRUE(junk_chunks == plain_chunks) << "the junk line changes no chunk";
   EXPECT_LT(junk_run.seconds, 5.0) << describe(junk_run);
+}
+
+// A DBC whose multiplexed signals no frame can carry: m300 on an 8-bit switch, a switch that is
+// a float, a switch that is itself in no frame. Such a DBC loads (with warnings); a profile that
+// maps one of those signals to a channel is refused at load, naming the DBC's file:line, the
+// message, the signal and why. It was accepted, and every row of the channel went invalid.
+const std::string kUnreachableMuxDbc =
+    "VERSION \"\"\n"
+    "BO_ 100 MUXED: 8 X\n"
+    " SG_ SEL M : 0|8@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ SPEED_300 m300 : 8|16@1+ (0.01,0) [0|0] \"m/s\" X\n"
+    " SG_ SPEED_3 m3 : 8|16@1+ (0.01,0) [0|0] \"m/s\" X\n"
+    "BO_ 200 FLOATSEL: 8 X\n"
+    " SG_ FSEL M : 0|32@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ V m1 : 32|16@1+ (0.01,0) [0|0] \"m/s\" X\n"
+    "BO_ 300 NESTED: 8 X\n"
+    " SG_ OUTER M : 0|4@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ INNER m20M : 4|4@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ DEEP m1 : 8|16@1+ (0.01,0) [0|0] \"m/s\" X\n"
+    "SIG_VALTYPE_ 200 FSEL : 1;\n"
+    "SG_MUL_VAL_ 300 DEEP INNER 1-1;\n";
+
+std::string mux_profile(const std::filesystem::path& dbc, const std::string& message,
+                        const std::string& signal) {
+  return "[vehicle]\nid = \"mux-car\"\ndbc = \"" + dbc.string() +
+         "\"\n[grid]\nrate_hz = 100.0\nchunk_seconds = 1.0\n[spool]\ndirectory = "
+         "\"spool\"\nmax_bytes = 1000000\n"
+         "[[channels]]\nname = \"vx\"\nmessage = \"" +
+         message + "\"\nsignal = \"" + signal + "\"\n";
+}
+
+TEST(HostileCar, AChannelWhoseMultiplexerValueItsSwitchCannotHoldIsRefusedAtLoad) {
+  ScratchDir scratch("hostile-mux");
+  const auto dbc = scratch.path() / "mux.dbc";
+  write_text(dbc, kUnreachableMuxDbc);
+  const auto log = scratch.path() / "can.log";
+  write_log(log, at_epoch(simulated_frames("tare")));
+
+  // The DBC loads: the message's reachable signal maps, and the parser says what it passed over.
+  const auto good = scratch.path() / "good.toml";
+  write_text(good, mux_profile(dbc, "MUXED", "SPEED_3"));
+  const car::VehicleProfile loaded = car::load_vehicle_profile(good);
+  EXPECT_EQ(loaded.channels.at(0).inputs.at(0).signal, "SPEED_3");
+  EXPECT_EQ(loaded.dbc->warnings.size(), 4u) << "SPEED_300, V, INNER and DEEP";
+
+  const std::vector<std::array<std::string, 3>> cases{
+      {"MUXED", "SPEED_300",
+       "mux.dbc:4: SG_ 'SPEED_300' of message 'MUXED' is in no frame: multiplexer value 300 is "
+       "beyond what its "
+       "switch 'SEL' (8 bits, 0..255) can hold"},
+      {"FLOATSEL", "V",
+       "mux.dbc:8: SG_ 'V' of message 'FLOATSEL' is in no frame: its switch 'FSEL' is a float "
+       "signal"},
+      {"NESTED", "DEEP",
+       "mux.dbc:12: SG_ 'DEEP' of message 'NESTED' is in no frame: its switch 'INNER' is never "
+       "present itself "
+       "(line 11)"}};
+  for (const auto& [message, signal, reason] : cases) {
+    SCOPED_TRACE(signal);
+    const auto profile = scratch.path() / (signal + ".toml");
+    const auto out = scratch.path() / (signal + ".chunks");
+    write_text(profile, mux_profile(dbc, message, signal));
+    const Outcome o = run(Program::Car,
+                          {"--profile", profile.string(), "--run", "r1", "--replay", log.string(),
+                           "--fast", "--chunks-out", out.string()},
+                          scratch);
+    EXPECT_EQ(o.exit, 1) << describe(o);
+    EXPECT_NE(o.output.find(profile.string() + ":13:"), std::string::npos) << describe(o);
+    EXPECT_NE(o.output.find("channels[0].signal: DBC signal '" + signal + "' of message '" +
+                            message + "' never gets a value"),
+              std::string::npos)
+        << describe(o);
+    EXPECT_NE(o.output.find(reason), std::string::npos) << describe(o);
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
 }
 
 // Case 4 of issue 19: a FIFO as the DBC, profile or log blocked dynid-car for ever. Every input

@@ -331,6 +331,12 @@ ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml
       r.fail(signals_key(t, key), "unknown DBC signal '" + name + "' in message '" + m.message + "' of " +
                                       p.dbc_path.filename().string(),
              signals_node(t));
+    if (const std::string& never = m.dbc_message->signals[*index].never_present; !never.empty())
+      r.fail(signals_key(t, key),
+             "DBC signal '" + name + "' of message '" + m.message +
+                 "' never gets a value (channel '" + m.channel +
+                 "' would be invalid in every row): " + never,
+             signals_node(t));
     SignalInput in{name, *index, {}, {}};
     in.to_si = input_conversion(r, t, key, m, m.dbc_message->signals[*index], in.dbc_unit);
     m.inputs.push_back(std::move(in));

@@ -16,7 +16,9 @@
 // reference against it. Every error throws InputError "<profile file>:<line>:<column>: <key>:
 // <reason>" (line and column when the key exists), for: a vehicle id that breaks the id rule
 // (input/ids.hpp), TOML syntax, missing keys and wrong types, unknown or
-// duplicate channel, unknown DBC message or signal, a DBC that cannot be read, a missing unit
+// duplicate channel, unknown DBC message or signal, a DBC signal no frame can carry (a
+// multiplexer value its switch cannot hold: can::Signal::never_present), a DBC that cannot be
+// read, a missing unit
 // (empty DBC unit for a dimensioned channel and no dbc_unit/factor), an unconvertible unit,
 // a non-finite or non-positive number where one is required, an unknown model or a model whose
 // constants it rejects, an unknown constant name in scale/divide_by; in [[sources]]: a name that
