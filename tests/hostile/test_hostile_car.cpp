@@ -4,6 +4,7 @@
 // Each: a clear message naming the input and the reason, exit 1 where the job cannot be done,
 // bounded time (every child runs under a time limit), and nothing written (no chunk file).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -303,6 +304,64 @@ TEST(HostileCar, AChannelWhoseMultiplexerValueItsSwitchCannotHoldIsRefusedAtLoad
         << describe(o);
     EXPECT_NE(o.output.find(reason), std::string::npos) << describe(o);
     EXPECT_FALSE(std::filesystem::exists(out));
+  }
+}
+
+// A model listed without a channel it needs: the server would leave it "not run: the run has no
+// channel ..." after the whole run was streamed. dynid-car refuses the run at start, naming each
+// such model, what it lacks (a derived d_<x> with what it is made from) and the optional channels
+// it lacks too, before anything is spooled, sent or written. (testcar.toml itself passes: its
+// models' d_vx, d_yaw_rate, ... are derived from channels it has.)
+TEST(HostileCar, AModelWithoutItsChannelsIsRefusedBeforeAnythingIsSent) {
+  ScratchDir scratch("hostile-models");
+  std::string text = read_text(testcar_profile());
+  text.replace(text.find("dbc = \"../dbc/"), std::string("dbc = \"../dbc/").size(),
+               "dbc = \"" + (source_dir() / "deploy" / "dbc").string() + "/");
+  for (const std::string channel :
+       {"yaw_rate", "roll"}) {  // each block: "[[channels]]\nname = ...\n..."
+    const std::size_t at = text.find("[[channels]]\nname = \"" + channel + "\"");
+    ASSERT_NE(at, std::string::npos) << channel;
+    text.erase(at, text.find("[[channels]]", at + 1) - at);
+  }
+  const auto profile = scratch.path() / "no-yaw.toml";
+  write_text(profile, text);
+  const auto log = scratch.path() / "can.log";
+  write_log(log, at_epoch(simulated_frames("tare")));
+  const auto out = scratch.path() / "run.chunks";
+  const auto spool = scratch.path() / "spool";
+  const std::string config = "file://" + loopback_xml().string() +
+                             ",<Discovery><Tag>dynid-hostile-models-" + std::to_string(getpid()) +
+                             "</Tag></Discovery>";
+  for (const auto& args :
+       std::vector<std::vector<std::string>>{{"--chunks-out", out.string()},
+                                             {"--cyclone-config", config, "--domain", "33",
+                                              "--spool", spool.string(), "--drain-timeout", "1"}}) {
+    SCOPED_TRACE(args.front());
+    std::vector<std::string> all{"--profile", profile.string(), "--run", "r1",
+                                 "--replay",  log.string(),     "--fast"};
+    all.insert(all.end(), args.begin(), args.end());
+    const Outcome o = run(Program::Car, all, scratch);
+    EXPECT_EQ(o.exit, 1) << describe(o);
+    EXPECT_NE(o.output.find(profile.string() +
+                            ": 2 models of [[models]] cannot run on this run's channels"),
+              std::string::npos)
+        << describe(o);
+    EXPECT_NE(
+        o.output.find(
+            "models[1] 'lateral_bicycle' needs 'yaw_rate' and 'd_yaw_rate' (the derivative of "
+            "'yaw_rate'), which this run does not have (it would also read 'roll', optional, "
+            "absent too)"),
+        std::string::npos)
+        << describe(o);
+    EXPECT_NE(
+        o.output.find(
+            "models[3] 'kinematic_lateral' needs 'yaw_rate', which this run does not have (it "
+            "would also read 'roll', optional, absent too)"),
+        std::string::npos)
+        << describe(o);
+    EXPECT_LT(o.seconds, 3.0) << describe(o);
+    EXPECT_FALSE(std::filesystem::exists(out)) << "no chunk written";
+    EXPECT_FALSE(std::filesystem::exists(spool)) << "no spool made, nothing sent";
   }
 }
 

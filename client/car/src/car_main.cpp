@@ -179,6 +179,23 @@ RunSources run_profile(const Options& options) {
   return run;
 }
 
+// A model the server could not run on this run's channels is refused before anything is
+// announced, spooled or written: otherwise the whole run streams and only the server says, at
+// its end, "not run: the run has no channel ...".
+void check_models(const Options& options, const VehicleProfile& profile) {
+  const std::vector<std::string> lacking = models_lacking_channels(profile);
+  if (lacking.empty()) return;
+  std::string text =
+      options.profile + ": " +
+      (lacking.size() == 1 ? "a model" : std::to_string(lacking.size()) + " models") +
+      " of [[models]] cannot run on this run's channels: ";
+  for (std::size_t i = 0; i < lacking.size(); ++i) text += (i == 0 ? "" : "; ") + lacking[i];
+  throw dynid::InputError(
+      text +
+      ". Map the channels in [[channels]] (or give the source that has them), or "
+      "remove the model");
+}
+
 // What the run left out: the auxiliary samples outside the bus's time, the samples no chunk may
 // carry, and the channels that made rows invalid, each named.
 void log_left_out(const CarPipeline& pipe) {
@@ -391,6 +408,7 @@ struct Session {
 int write_chunks(const Options& options) {
   RunSources sources = run_profile(options);
   const VehicleProfile& profile = sources.profile;
+  check_models(options, profile);
   if (!options.replay.empty()) probe_log(options, profile);
   // The source is opened before the chunk file is created: a bus that cannot be read leaves none.
   std::optional<SocketCanSource> live;
@@ -428,6 +446,7 @@ int run(const Options& options, ProgressDisplay& display) {
   const std::string cyclone_config = dynid::dds::config_uri(options.cyclone_config);
   RunSources sources = run_profile(options);
   const VehicleProfile& profile = sources.profile;
+  if (!options.replay.empty() || !options.can.empty()) check_models(options, profile);  // a new run
   if (!options.replay.empty()) probe_log(options, profile);
   const std::filesystem::path spool_dir = options.spool.empty() ? profile.spool_directory : std::filesystem::path(options.spool);
   Spool spool(spool_dir, profile.spool_max_bytes);

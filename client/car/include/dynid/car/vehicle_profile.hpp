@@ -149,6 +149,14 @@ struct VehicleProfile {
   ingest::RunAnnouncement announcement(const std::string& run) const;
 };
 
+/// The models of a run's profile (the bus channels and those of the sources given for the run:
+/// auxiliary.hpp) that the server could not run for want of a channel, by the server's own rule
+/// (ingest/model_channels.hpp: derived d_<x> count when <x> is a channel; constants never stand
+/// in for one): one line each, "models[i] '<name>' needs ..., which this run does not have",
+/// with the optional channels it also lacks and the declared sources not given that have them.
+/// Empty when every model can run. dynid-car refuses such a run before anything is sent.
+std::vector<std::string> models_lacking_channels(const VehicleProfile& profile);
+
 VehicleProfile load_vehicle_profile(const std::filesystem::path& path);
 /// Parses profile text; `source` names it in messages and relative paths resolve against its
 /// parent folder.
