@@ -154,7 +154,8 @@ std::string config_uri(const std::string& value) {
   for (std::size_t start = 0; start <= value.size();) {
     const auto comma = std::min(value.find(',', start), value.size());
     const std::string_view item = std::string_view(value).substr(start, comma - start);
-    if (item.substr(0, kFile.size()) == kFile) config_file_uri(std::string(item.substr(kFile.size())));
+    if (item.substr(0, kFile.size()) == kFile)
+      config_file_uri(std::string(item.substr(kFile.size())));
     start = comma + 1;
   }
   return value;
@@ -165,8 +166,8 @@ Participant::Participant(const ParticipantOptions& options) : domain_id_(options
     throw DdsError("Participant: no Cyclone configuration given (the default one is never used)",
                    DDS_RETCODE_BAD_PARAMETER);
   domain_ = acquire_domain(options);
-  participant_ = Entity(check(dds_create_participant(options.domain_id, nullptr, nullptr),
-                              "dds_create_participant"));
+  participant_ = Entity(
+      check(dds_create_participant(options.domain_id, nullptr, nullptr), "dds_create_participant"));
 }
 
 Participant::~Participant() = default;

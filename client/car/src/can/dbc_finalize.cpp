@@ -101,16 +101,16 @@ class MessageChecker {
 
   void check_layout(std::size_t i) {
     const Signal& s = m_.signals[i];
-    if (s.length < 1 || s.length > 64) fail(i, "length " + std::to_string(s.length) +
-                                                   " is outside 1..64 bits");
+    if (s.length < 1 || s.length > 64)
+      fail(i, "length " + std::to_string(s.length) + " is outside 1..64 bits");
     if (s.value_type == ValueType::Float32 && s.length != 32)
-      fail(i, "a float signal (SIG_VALTYPE_ 1) must be 32 bits long, not " +
-                  std::to_string(s.length));
+      fail(i,
+           "a float signal (SIG_VALTYPE_ 1) must be 32 bits long, not " + std::to_string(s.length));
     if (s.value_type == ValueType::Float64 && s.length != 64)
       fail(i, "a double signal (SIG_VALTYPE_ 2) must be 64 bits long, not " +
                   std::to_string(s.length));
-    if (s.start_bit >= kMaxBits) fail(i, "start bit " + std::to_string(s.start_bit) +
-                                             " is beyond 64 bytes");
+    if (s.start_bit >= kMaxBits)
+      fail(i, "start bit " + std::to_string(s.start_bit) + " is beyond 64 bytes");
     const ByteSpan span = signal_bytes(s);
     if (span.last >= 64 || (s.byte_order == ByteOrder::Intel && s.start_bit + s.length > kMaxBits))
       fail(i, "bits run past byte 64 (start " + std::to_string(s.start_bit) + ", length " +
@@ -122,8 +122,10 @@ class MessageChecker {
   void link_multiplexer(std::size_t i) {
     Signal& s = m_.signals[i];
     if (!s.is_multiplexed()) {
-      if (!s.multiplexer.empty()) fail(i, "SG_MUL_VAL_ names a switch but the signal has no "
-                                          "multiplexer indicator (m<value>)");
+      if (!s.multiplexer.empty())
+        fail(i,
+             "SG_MUL_VAL_ names a switch but the signal has no "
+             "multiplexer indicator (m<value>)");
       return;
     }
     if (s.multiplexer.empty()) s.multiplexer = plain_switch(i);
@@ -148,8 +150,9 @@ class MessageChecker {
                     "') and no SG_MUL_VAL_ says which one selects this signal");
       found = s.name;
     }
-    if (found.empty()) fail(i, "multiplexed (m" + std::to_string(*m_.signals[i].mux_value) +
-                                   ") but message '" + m_.name + "' has no switch signal (M)");
+    if (found.empty())
+      fail(i, "multiplexed (m" + std::to_string(*m_.signals[i].mux_value) + ") but message '" +
+                  m_.name + "' has no switch signal (M)");
     return found;
   }
 
@@ -246,11 +249,13 @@ std::string set_message_id(Message& m, std::uint32_t raw_id) {
     m.is_pseudo = true;
     m.id = 0;
     if (raw_id == kPseudoMessageId || raw_id == (kPseudoMessageId & ~kDbcExtendedFlag)) return {};
-    return "id " + std::to_string(raw_id) + " has more than 29 bits: kept as a pseudo message "
+    return "id " + std::to_string(raw_id) +
+           " has more than 29 bits: kept as a pseudo message "
            "that no frame can address";
   }
   if (key != raw_id)
-    return "id " + std::to_string(raw_id) + " exceeds 11 bits without the extended flag "
+    return "id " + std::to_string(raw_id) +
+           " exceeds 11 bits without the extended flag "
            "(bit 31): taken as a 29-bit id";
   return {};
 }
