@@ -484,8 +484,8 @@ std::string HiddenStructure::statement() const {
       material() ? "at least" : "less than", resolution);
   return std::string(buf) + (material()
                                  ? ""
-                                 : ": immaterial to the declared parameters, a note (no candidate "
-                                   "expresses it, so nothing says which parameter it would move)");
+                                 : ": immaterial by that measure, a note (no candidate expresses "
+                                   "it, so nothing says which parameter it would move)");
 }
 
 const char* verdict_name(Verdict verdict) {
