@@ -192,6 +192,14 @@ while IFS=$'\t' read -r -u 3 run log models refs; do
   fi
   request close "$reply/close.json" 300 --json close --vehicle "$vehicle" --run "$run"
   request estimates "$reply/estimates.json" 120 --json estimates --vehicle "$vehicle" --run "$run"
+  # The published values: the server's bias test runs once the run is closed (docs/USAGE.md);
+  # asked again until a table carries it (at most 60 s).
+  for _ in $(seq 60); do
+    /usr/bin/python3 -c 'import json, sys; t = json.load(open(sys.argv[1])).get("tables", [])
+sys.exit(0 if any(x.get("bias_test") for x in t) else 1)' "$reply/estimates.json" 2> /dev/null && break
+    sleep 1
+    request estimates "$reply/estimates.json" 120 --json estimates --vehicle "$vehicle" --run "$run"
+  done
   request consistency "$reply/consistency.json" "$request_timeout" --json consistency --vehicle "$vehicle" --run "$run"
   IFS=, read -r -a model_list <<< "$models"
   for model in "${model_list[@]}"; do

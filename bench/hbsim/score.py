@@ -383,6 +383,21 @@ def published_errors(estimates, model, truth):
     return {}
 
 
+def coverage(estimates, truths):
+    """Per published parameter with a truth and the status "identified": (model, name, z) with
+    z = (value - truth) / std, the std the table publishes."""
+    out = []
+    for t in (estimates or {}).get("tables", []):
+        truth = truths.get(t.get("model"), {})
+        for p in t.get("parameters", []):
+            if p["name"] not in truth or p.get("status") != "identified":
+                continue
+            if p.get("value") is None or not p.get("std"):
+                continue
+            out.append((t["model"], p["name"], (p["value"] - truth[p["name"]]) / p["std"]))
+    return out
+
+
 def reference_use(ref_trace, args_path):
     """Which --reference names the trace shows with a reference value."""
     given = []
@@ -455,6 +470,7 @@ def main(argv=None):
         manifest = json.load(f)
 
     effect_rows, clean_rows, diag_rows, cons_rows, time_rows, ref_rows = [], [], [], [], [], []
+    cover_rows = []  # (run, model, parameter, z) of the clean runs' identified published values
     for run in manifest["runs"]:
         name = run["run"]
         if run["kind"] == "clean" and args.clean_seeds is not None and int(name.rsplit("-c", 1)[1]) > args.clean_seeds:
@@ -468,6 +484,8 @@ def main(argv=None):
         time_rows.append({"run": name, "timings": t, "noise": channel_noise(reply)})
         models = run["target_models"] if run["kind"] == "effect" else list(run["truth"])
         estimates, _ = load_json(os.path.join(reply, "estimates.json"))
+        if run["kind"] == "clean":
+            cover_rows.extend((name,) + c for c in coverage(estimates, run["truth"]))
         cons, cons_err = load_json(os.path.join(reply, "consistency.json"))
         cf = consistency_findings(cons)
         cons_rows.append({"run": name, "kind": run["kind"], "case": run["case"],
@@ -614,6 +632,12 @@ def main(argv=None):
         print(f"diagnostic traces with an alarm: {sum(1 for r in diag_rows if r.get('alarm'))} of {len(diag_rows)}")
     if trace_secs:
         print(f"trace requests: {len(trace_secs)}, {sum(trace_secs):.0f} s in all, longest {max(trace_secs):.1f} s")
+    within = sum(1 for c in cover_rows if abs(c[3]) <= 2.0)
+    far = [c for c in cover_rows if abs(c[3]) > 5.0]
+    if cover_rows:
+        print(f"coverage, clean runs' identified published values: |error| <= 2 std for {within} of {len(cover_rows)}"
+              f" ({100.0 * within / len(cover_rows):.0f} %); more than 5 std off: {len(far)}"
+              + (" (" + "; ".join(f"{r} {m} {p} z={z:+.1f}" for r, m, p, z in far) + ")" if far else ""))
 
     summary = {
         "right_first_answer": right, "effect_traces": len(effect_rows),
@@ -621,6 +645,7 @@ def main(argv=None):
         "false_alarms_per_model": per_model,
         "consistency_alarms_clean": sum(1 for c in clean_cons if c["alarm"]), "clean_runs": len(clean_cons),
         "clean_traces_further": len({(a, b) for a, b, _ in further}),
+        "coverage": {"within_2_std": within, "identified": len(cover_rows), "beyond_5_std": len(far)},
         "effect": effect_rows, "clean": clean_rows, "diagnostic": diag_rows, "consistency": cons_rows,
         "reference": ref_rows, "timings": time_rows,
     }

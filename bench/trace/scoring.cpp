@@ -114,13 +114,15 @@ ModelRun trace_model(const RunSetup& setup, const std::string& name, const inges
 }
 
 // The product's consistency check (residual/consistency.hpp) over the run's models as declared:
-// shared parameters compared within their HAC std. Flagged: a significant disagreement.
+// shared parameters compared within their HAC std, on the values `dynid consistency` weighs.
+// Flagged: a significant disagreement.
 void cross_check(const RunSetup& setup, const std::vector<std::string>& models,
                  const std::vector<ingest::PreprocessedSegment>& segments, const ingest::RecordedRun& run,
                  RunResult& r) {
   if (models.size() < 2) return;
   std::vector<residual::ModelParameters> fits;
-  for (const std::string& name : models) fits.push_back(benchcar::declared_hac(*setup.profile, name, run, segments));
+  for (const std::string& name : models)
+    fits.push_back(benchcar::declared_compared(*setup.profile, name, run, segments));
   const residual::Consistency c = residual::check_consistency(fits, {});
   r.cross_checked = !c.comparisons.empty();
   r.cross_flagged = !c.consistent();

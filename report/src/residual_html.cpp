@@ -71,20 +71,6 @@ std::string base64(const std::string& bytes) {
   return out;
 }
 
-std::string html_escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 // Runs `gnuplot script` in `dir`; throws naming gnuplot and quoting its stderr on failure.
 void run_gnuplot(const std::string& program, const fs::path& dir, const fs::path& script) {
   const fs::path err = dir / "gnuplot.err";
@@ -289,6 +275,20 @@ constexpr const char* kImageCheck =
     "document.body.setAttribute('data-images',k+'/'+i.length);});</script>";
 
 }  // namespace
+
+std::string html_escape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
 
 std::string residual_html(const HtmlReportInput& in) {
   const residual::ModelFit* before = in.comparison != nullptr ? &in.comparison->before

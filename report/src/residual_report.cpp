@@ -127,15 +127,27 @@ std::string format_diagnosis_text(const residual::Diagnosis& d, std::size_t top)
   return out + "diagnosis: " + d.statement() + "\n";
 }
 
+namespace {
+
+// A model's name in the consistency table, with " (IV)" where its values are IV's.
+std::string by_estimator(const std::string& model, const std::string& estimator) {
+  return estimator.empty() || estimator == "least squares" ? model : model + " (" + estimator + ")";
+}
+
+}  // namespace
+
 std::string format_consistency_text(const residual::Consistency& c, const std::vector<std::string>& left_out) {
   std::string out;
   if (!c.comparisons.empty())
     out += fmt::format("{:<22} {:<22} {:>14} {:>10} {:<22} {:>14} {:>10} {:>7}\n", "parameter", "model", "value", "std",
                        "against", "value", "std", "z");
   for (const residual::ParameterAgreement& a : c.comparisons)
-    out += fmt::format("{:<22} {:<22} {:>14} {:>10} {:<22} {:>14} {:>10} {:>+7.2f}{}\n", a.parameter + " [" + a.unit + "]",
-                       a.first, number(a.first_value), number(a.first_std), a.second, number(a.second_value),
-                       a.second == residual::kReference ? "-" : number(a.second_std), a.z, a.significant ? " *" : "");
+    out += fmt::format("{:<22} {:<22} {:>14} {:>10} {:<22} {:>14} {:>10} {:>+7.2f}{}\n",
+                       a.parameter + " [" + a.unit + "]", by_estimator(a.first, a.first_estimator),
+                       number(a.first_value), number(a.first_std),
+                       by_estimator(a.second, a.second_estimator), number(a.second_value),
+                       a.second == residual::kReference ? "-" : number(a.second_std), a.z,
+                       a.significant ? " *" : "");
   if (!c.comparisons.empty())
     out += fmt::format("(* beyond the level {:.2g}: family error rate 1 % over {} comparisons; std are HAC)\n", c.level,
                        c.tests);
@@ -239,30 +251,40 @@ json diagnosis_object(const residual::Diagnosis& d) {
                             {"lag_s", f.lag_s},
                             {"correlation", finite(f.correlation)},
                             {"bound", finite(f.bound)}});
-  return {{"model", d.screen.fit.model},
-          {"effects", d.screen.fit.effects},
-          {"verdict", residual::verdict_name(d.verdict)},
-          {"statement", d.statement()},
-          {"accepted", d.accepted ? json(d.accepted->effect) : json(nullptr)},
-          // The accepted candidate explains a part only: its model stays above its own floor.
-          {"partial", d.partial ? json({{"group", d.partial->group},
-                                        {"ratio", finite(d.partial->ratio)},
-                                        {"upper_ratio", finite(d.partial->upper_ratio)},
-                                        {"masked", d.masked}})
-                                : json(nullptr)},
-          {"floor", {{"groups", groups}, {"channels", noise}, {"contributing", d.floor.contributing}}},
-          {"candidate_level", finite(d.screen.level)},
-          {"candidates", candidates},
-          {"refused", refused},
-          {"inseparable", inseparable},
-          {"implausible", d.implausible},
-          {"signature",
-           {{"correlations", correlations},
-            {"span_group", d.signature.span_group},
-            {"span_start_s", d.signature.span_start_s},
-            {"span_end_s", d.signature.span_end_s},
-            {"span_ratio", finite(d.signature.span_ratio)},
-            {"peak_frequency_hz", finite(d.signature.peak_frequency_hz)}}}};
+  return {
+      {"model", d.screen.fit.model},
+      {"effects", d.screen.fit.effects},
+      {"verdict", residual::verdict_name(d.verdict)},
+      {"statement", d.statement()},
+      {"accepted", d.accepted ? json(d.accepted->effect) : json(nullptr)},
+      // The accepted candidate explains a part only: its model stays above its own floor.
+      {"partial", d.partial ? json({{"group", d.partial->group},
+                                    {"ratio", finite(d.partial->ratio)},
+                                    {"upper_ratio", finite(d.partial->upper_ratio)},
+                                    {"masked", d.masked}})
+                            : json(nullptr)},
+      // Structure a better sensor shows under the declared floor, too small to matter: a note.
+      {"hidden", d.hidden ? json({{"sensor", d.hidden->sensor},
+                                  {"group", d.hidden->group},
+                                  {"residual_rms", finite(d.hidden->residual_rms)},
+                                  {"floor_rms", finite(d.hidden->floor_rms)},
+                                  {"share", finite(d.hidden->share)},
+                                  {"resolution", finite(d.hidden->resolution)},
+                                  {"statement", d.hidden->statement()}})
+                          : json(nullptr)},
+      {"floor", {{"groups", groups}, {"channels", noise}, {"contributing", d.floor.contributing}}},
+      {"candidate_level", finite(d.screen.level)},
+      {"candidates", candidates},
+      {"refused", refused},
+      {"inseparable", inseparable},
+      {"implausible", d.implausible},
+      {"signature",
+       {{"correlations", correlations},
+        {"span_group", d.signature.span_group},
+        {"span_start_s", d.signature.span_start_s},
+        {"span_end_s", d.signature.span_end_s},
+        {"span_ratio", finite(d.signature.span_ratio)},
+        {"peak_frequency_hz", finite(d.signature.peak_frequency_hz)}}}};
 }
 
 json fit_groups(const residual::ModelFit& f) {
@@ -327,9 +349,11 @@ std::string consistency_json(const residual::Consistency& c, const std::vector<s
     comparisons.push_back({{"parameter", a.parameter},
                            {"unit", a.unit},
                            {"model", a.first},
+                           {"estimator", a.first_estimator},
                            {"value", finite(a.first_value)},
                            {"std", finite(a.first_std)},
                            {"against", a.second},
+                           {"against_estimator", a.second_estimator},
                            {"against_value", finite(a.second_value)},
                            {"against_std", finite(a.second_std)},
                            {"z", finite(a.z)},

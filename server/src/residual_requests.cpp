@@ -96,21 +96,6 @@ ResidualReply trace_reply(const residual::Trace& t, const std::string& title,
   return {report::format_trace_text(t), "text/plain"};
 }
 
-std::string escape_html(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else
-      out += c;
-  }
-  return out;
-}
-
 // The reply for a model read from an unhealthy channel: one line in place of any judgement.
 ResidualReply not_identified_reply(const std::string& title, const std::string& model,
                                    const std::string& reason, const std::string& format) {
@@ -120,8 +105,8 @@ ResidualReply not_identified_reply(const std::string& title, const std::string& 
                 ",\"not_identified\":" + report::json_string(reason) + "}",
             "application/json"};
   if (format == "html")
-    return {"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>" + escape_html(title) +
-                "</title></head><body><p>" + escape_html(title + ": " + line) +
+    return {"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>" + report::html_escape(title) +
+                "</title></head><body><p>" + report::html_escape(title + ": " + line) +
                 "</p></body></html>\n",
             "text/html"};
   return {title + ": " + line + "\n", "text/plain"};
@@ -142,8 +127,7 @@ ResidualReply consistency_reply(const ingest::RunAnnouncement& announcement,
         left_out.push_back(spec.model + ": " + ingest::not_identified(*reason));
         continue;
       }
-      fits.push_back(residual::hac_parameters(*model, spec.effects, segments, announcement.sample_rate_hz,
-                                              announcement.preprocessing.odmf));
+      fits.push_back(residual::compared_parameters(*model, spec.effects, segments, announcement));
     } catch (const InputError& e) {
       left_out.push_back(spec.model + ": " + e.what());
     }
@@ -268,7 +252,8 @@ residual::SimexFit simex_of(const model::Model& model, const std::vector<std::st
 
 std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& announcement,
                                                  const std::vector<ingest::Chunk>& chunks,
-                                                 const std::vector<std::string>& models) {
+                                                 const std::vector<std::string>& models,
+                                                 bool diagnose) {
   std::map<std::string, LiveVerdict> out;
   const ingest::RecordedRun run = ingest::assemble_run(announcement, chunks);
   const auto segments = ingest::preprocess_offline(run);
@@ -289,10 +274,15 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
     // No verdict on a model read from an unhealthy channel: "adequate" would read as a result.
     if (ingest::unhealthy_reason(health, announcement, *model, spec.effects)) continue;
     try {
-      const residual::Diagnosis d = residual::diagnose(*model, spec.effects, run, segments, options);
-      const bool measured = std::all_of(d.floor.groups.begin(), d.floor.groups.end(),
-                                        [](const residual::GroupFloor& g) { return g.rows == 0 || g.floor_rms > 0.0; });
-      if (measured) verdict.verdict = residual::verdict_name(d.verdict), verdict.statement = d.statement();
+      if (diagnose) {
+        const residual::Diagnosis d =
+            residual::diagnose(*model, spec.effects, run, segments, options);
+        const bool measured = std::all_of(
+            d.floor.groups.begin(), d.floor.groups.end(),
+            [](const residual::GroupFloor& g) { return g.rows == 0 || g.floor_rms > 0.0; });
+        if (measured)
+          verdict.verdict = residual::verdict_name(d.verdict), verdict.statement = d.statement();
+      }
     } catch (const InputError&) {
       // Not diagnosable yet (no row of this model so far): no verdict rather than a wrong one.
     }

@@ -453,9 +453,9 @@ void RunService::stamp_revisions(const RunState& run, EstimateTables& tables) {
 }
 
 void RunService::refresh_residual(const store::RunKey& key, const RunState& run) {
-  if (context_.options.live_residual_interval.count() == 0 || run.contiguous < 0 ||
-      run.contiguous == run.residual_through)
-    return;
+  if (run.contiguous < 0 || run.contiguous == run.residual_through) return;
+  // Without the live verdict, a closed run still gets the publication's IV and SIMEX fits, once.
+  if (context_.options.live_residual_interval.count() == 0 && !run.processor.finished()) return;
   residual_stale_.insert(key);
   start_residual_job();
 }
@@ -487,13 +487,14 @@ void RunService::start_residual_job() {
         if (t.not_excited.empty()) models.push_back(t.model);
       // Read here: the store is this worker's to read.
       replay_stored(*it, *run, [&](const ingest::Chunk& chunk) { chunks.push_back(chunk); });
+      const bool diagnose = context_.options.live_residual_interval.count() != 0;
       residual_job_.emplace(ResidualJob{
           *it, run->contiguous,
           std::async(std::launch::async, [announcement = run->processor.announcement(),
                                           chunks = std::move(chunks), models = std::move(models),
-                                          stopping = context_.stopping] {
+                                          stopping = context_.stopping, diagnose] {
             const CancellationScope scope(stopping);  // a stop does not wait for the verdict
-            return live_verdicts(announcement, chunks, models);
+            return live_verdicts(announcement, chunks, models, diagnose);
           })});
     } catch (const std::exception& e) {
       // A stored chunk that cannot be read back, or no thread to be had: no verdict, and the

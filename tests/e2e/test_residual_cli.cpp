@@ -418,6 +418,51 @@ TEST(E2eResidualCli, WhereTheBiasTestRejectsLeastSquaresTheTablesCarryTheIvValue
   EXPECT_EQ(html.status, dds::ReplyStatus::kBadRequest);
 }
 
+// Without --live-residual, a closed run's tables still publish what the publication rule chooses:
+// the bias test runs once at the close (no verdict), and where it rejects least squares the
+// values are IV's, those `dynid iv` gives on the stored run. Before the close, least squares.
+TEST(E2eResidualCli, WithoutTheLiveVerdictAClosedRunsTablesCarryTheIvValues) {
+  TempDir dir;
+  InProcessServer server(server_options(dir.file("store.db")));  // live residual off
+  ingest::test::Truth truth;
+  truth.vx_noise = 0.15;
+  const auto run = test_run("iv-closed", "run-c", 53u, truth);
+  const auto chunks = cut_run(run, 6u);
+  TestCar car("iv-closed");
+  ASSERT_TRUE(car.stream(run.announcement, chunks));
+  const std::vector<std::string> where{"--vehicle", "iv-closed", "--run",
+                                       "run-c",     "--model",   "kinematic_longitudinal"};
+  const auto table_now = [&] {
+    std::vector<std::string> args{"--json", "estimates"};
+    args.insert(args.end(), where.begin(), where.end());
+    const auto reply = dynid(args);
+    EXPECT_EQ(reply.exit_code, 0) << reply.err;
+    return nlohmann::json::parse(reply.out)["tables"][0];
+  };
+  const auto open = table_now();
+  EXPECT_EQ(open["estimator"], "least squares") << open.dump();
+  EXPECT_EQ(open["bias_test"], "") << open.dump();
+  ASSERT_EQ(dynid({"close", "--vehicle", "iv-closed", "--run", "run-c"}).exit_code, 0);
+
+  std::vector<std::string> args{"--json", "iv"};
+  args.insert(args.end(), where.begin(), where.end());
+  const auto direct = dynid(args);
+  ASSERT_EQ(direct.exit_code, 0) << direct.err;
+  const auto iv = nlohmann::json::parse(direct.out);
+  ASSERT_TRUE(iv["replaces_least_squares"].get<bool>()) << iv.dump(1);
+  nlohmann::json table;
+  for (int attempt = 0; attempt < 120 && table.is_null(); ++attempt) {
+    const auto t = table_now();
+    if (t["estimator"] == "instrumental variables")
+      table = t;
+    else
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+  ASSERT_FALSE(table.is_null()) << "no IV values after the close";
+  EXPECT_EQ(table["parameters"][0]["value"], iv["parameters"][0]["iv"]);
+  EXPECT_EQ(table["parameters"][0]["std"], iv["parameters"][0]["iv_hac_std"]);
+  EXPECT_EQ(table["residual_verdict"], "") << "a verdict without --live-residual";
+}
 
 // Issue 16 item 2, where the bias test does not reject: the tables carry least squares corrected
 // for the measured sensor noise (SIMEX) on every identified row, the least-squares values

@@ -4,7 +4,9 @@
 // Each: a clear message naming the input and the reason, exit 1 where the job cannot be done,
 // bounded time (every child runs under a time limit), and nothing written (no chunk file).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -12,6 +14,7 @@
 
 #include <dynid/can/candump.hpp>
 #include <dynid/car/chunk_file.hpp>
+#include <dynid/car/vehicle_profile.hpp>
 
 #include "hostile_support.hpp"
 
@@ -183,6 +186,182 @@ TEST(HostileCar, AFileThatIsNoCanLogFailsNamingItAndWritesNothing) {
     EXPECT_FALSE(std::filesystem::exists(out)) << "nothing is written for a file that is no log";
     for (const char c : o.output)  // the file's bytes are shown escaped
       ASSERT_TRUE(c == '\n' || (c >= 0x20 && c < 0x7f)) << "unescaped byte " << int(c) << " in " << describe(o);
+  }
+}
+
+// A line of megabytes of junk in a good log is one bad line: skipped to its end, every frame
+// delivered. It once counted as one bad line per KiB and outvoted the frames around it ("most
+// lines or objects are not CAN frames", exit 1); here 8192 pieces against 6000 frames would.
+TEST(HostileCar, AJunkLineOfMegabytesIsOneBadLineAndEveryFrameIsDelivered) {
+  ScratchDir scratch("hostile-long-line");
+  const std::vector<can::Frame> all = at_epoch(simulated_frames());
+  const std::vector<can::Frame> frames(all.begin(), all.begin() + 6000);
+  std::ostringstream good;
+  std::ostringstream junked;
+  {
+    can::CandumpWriter plain(good);
+    can::CandumpWriter with_junk(junked);
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      if (i == 3000) junked << std::string(8u << 20, 'x') << "\n";
+      plain.write(frames[i]);
+      with_junk.write(frames[i]);
+    }
+  }
+  const auto chunks_of = [&](const std::string& name, const std::string& text) {
+    const auto log = scratch.path() / (name + ".log");
+    const auto out = scratch.path() / (name + ".chunks");
+    write_text(log, text);
+    const Outcome o = run(Program::Car,
+                          {"--profile", testcar_profile().string(), "--run", "r1", "--replay",
+                           log.string(), "--fast", "--chunks-out", out.string()},
+                          scratch, 20s);
+    return std::make_pair(o, std::filesystem::exists(out) ? read_text(out) : std::string());
+  };
+  const auto [plain_run, plain_chunks] = chunks_of("plain", good.str());
+  ASSERT_EQ(plain_run.exit, 0) << describe(plain_run);
+  const auto [junk_run, junk_chunks] = chunks_of("junk", junked.str());
+  ASSERT_EQ(junk_run.exit, 0) << describe(junk_run);
+  EXPECT_NE(junk_run.output.find("6000 frames (1 bad lines"), std::string::npos)
+      << describe(junk_run);
+  EXPECT_NE(junk_run.output.find(
+                "junk.log:3001: line of 8388608 bytes, longer than the 1024 a line may have"),
+            std::string::npos)
+      << describe(junk_run);
+  EXPECT_FALSE(plain_chunks.empty());
+  EXPECT_TRUE(junk_chunks == plain_chunks) << "the junk line changes no chunk";
+  EXPECT_LT(junk_run.seconds, 5.0) << describe(junk_run);
+}
+
+// A DBC whose multiplexed signals no frame can carry: m300 on an 8-bit switch, a switch that is
+// a float, a switch that is itself in no frame. Such a DBC loads (with warnings); a profile that
+// maps one of those signals to a channel is refused at load, naming the DBC's file:line, the
+// message, the signal and why. It was accepted, and every row of the channel went invalid.
+const std::string kUnreachableMuxDbc =
+    "VERSION \"\"\n"
+    "BO_ 100 MUXED: 8 X\n"
+    " SG_ SEL M : 0|8@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ SPEED_300 m300 : 8|16@1+ (0.01,0) [0|0] \"m/s\" X\n"
+    " SG_ SPEED_3 m3 : 8|16@1+ (0.01,0) [0|0] \"m/s\" X\n"
+    "BO_ 200 FLOATSEL: 8 X\n"
+    " SG_ FSEL M : 0|32@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ V m1 : 32|16@1+ (0.01,0) [0|0] \"m/s\" X\n"
+    "BO_ 300 NESTED: 8 X\n"
+    " SG_ OUTER M : 0|4@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ INNER m20M : 4|4@1+ (1,0) [0|0] \"\" X\n"
+    " SG_ DEEP m1 : 8|16@1+ (0.01,0) [0|0] \"m/s\" X\n"
+    "SIG_VALTYPE_ 200 FSEL : 1;\n"
+    "SG_MUL_VAL_ 300 DEEP INNER 1-1;\n";
+
+std::string mux_profile(const std::filesystem::path& dbc, const std::string& message,
+                        const std::string& signal) {
+  return "[vehicle]\nid = \"mux-car\"\ndbc = \"" + dbc.string() +
+         "\"\n[grid]\nrate_hz = 100.0\nchunk_seconds = 1.0\n[spool]\ndirectory = "
+         "\"spool\"\nmax_bytes = 1000000\n"
+         "[[channels]]\nname = \"vx\"\nmessage = \"" +
+         message + "\"\nsignal = \"" + signal + "\"\n";
+}
+
+TEST(HostileCar, AChannelWhoseMultiplexerValueItsSwitchCannotHoldIsRefusedAtLoad) {
+  ScratchDir scratch("hostile-mux");
+  const auto dbc = scratch.path() / "mux.dbc";
+  write_text(dbc, kUnreachableMuxDbc);
+  const auto log = scratch.path() / "can.log";
+  write_log(log, at_epoch(simulated_frames("tare")));
+
+  // The DBC loads: the message's reachable signal maps, and the parser says what it passed over.
+  const auto good = scratch.path() / "good.toml";
+  write_text(good, mux_profile(dbc, "MUXED", "SPEED_3"));
+  const car::VehicleProfile loaded = car::load_vehicle_profile(good);
+  EXPECT_EQ(loaded.channels.at(0).inputs.at(0).signal, "SPEED_3");
+  EXPECT_EQ(loaded.dbc->warnings.size(), 4u) << "SPEED_300, V, INNER and DEEP";
+
+  const std::vector<std::array<std::string, 3>> cases{
+      {"MUXED", "SPEED_300",
+       "mux.dbc:4: SG_ 'SPEED_300' of message 'MUXED' is in no frame: multiplexer value 300 is "
+       "beyond what its "
+       "switch 'SEL' (8 bits, 0..255) can hold"},
+      {"FLOATSEL", "V",
+       "mux.dbc:8: SG_ 'V' of message 'FLOATSEL' is in no frame: its switch 'FSEL' is a float "
+       "signal"},
+      {"NESTED", "DEEP",
+       "mux.dbc:12: SG_ 'DEEP' of message 'NESTED' is in no frame: its switch 'INNER' is never "
+       "present itself "
+       "(line 11)"}};
+  for (const auto& [message, signal, reason] : cases) {
+    SCOPED_TRACE(signal);
+    const auto profile = scratch.path() / (signal + ".toml");
+    const auto out = scratch.path() / (signal + ".chunks");
+    write_text(profile, mux_profile(dbc, message, signal));
+    const Outcome o = run(Program::Car,
+                          {"--profile", profile.string(), "--run", "r1", "--replay", log.string(),
+                           "--fast", "--chunks-out", out.string()},
+                          scratch);
+    EXPECT_EQ(o.exit, 1) << describe(o);
+    EXPECT_NE(o.output.find(profile.string() + ":13:"), std::string::npos) << describe(o);
+    EXPECT_NE(o.output.find("channels[0].signal: DBC signal '" + signal + "' of message '" +
+                            message + "' never gets a value"),
+              std::string::npos)
+        << describe(o);
+    EXPECT_NE(o.output.find(reason), std::string::npos) << describe(o);
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+}
+
+// A model listed without a channel it needs: the server would leave it "not run: the run has no
+// channel ..." after the whole run was streamed. dynid-car refuses the run at start, naming each
+// such model, what it lacks (a derived d_<x> with what it is made from) and the optional channels
+// it lacks too, before anything is spooled, sent or written. (testcar.toml itself passes: its
+// models' d_vx, d_yaw_rate, ... are derived from channels it has.)
+TEST(HostileCar, AModelWithoutItsChannelsIsRefusedBeforeAnythingIsSent) {
+  ScratchDir scratch("hostile-models");
+  std::string text = read_text(testcar_profile());
+  text.replace(text.find("dbc = \"../dbc/"), std::string("dbc = \"../dbc/").size(),
+               "dbc = \"" + (source_dir() / "deploy" / "dbc").string() + "/");
+  for (const std::string channel :
+       {"yaw_rate", "roll"}) {  // each block: "[[channels]]\nname = ...\n..."
+    const std::size_t at = text.find("[[channels]]\nname = \"" + channel + "\"");
+    ASSERT_NE(at, std::string::npos) << channel;
+    text.erase(at, text.find("[[channels]]", at + 1) - at);
+  }
+  const auto profile = scratch.path() / "no-yaw.toml";
+  write_text(profile, text);
+  const auto log = scratch.path() / "can.log";
+  write_log(log, at_epoch(simulated_frames("tare")));
+  const auto out = scratch.path() / "run.chunks";
+  const auto spool = scratch.path() / "spool";
+  const std::string config = "file://" + loopback_xml().string() +
+                             ",<Discovery><Tag>dynid-hostile-models-" + std::to_string(getpid()) +
+                             "</Tag></Discovery>";
+  for (const auto& args :
+       std::vector<std::vector<std::string>>{{"--chunks-out", out.string()},
+                                             {"--cyclone-config", config, "--domain", "33",
+                                              "--spool", spool.string(), "--drain-timeout", "1"}}) {
+    SCOPED_TRACE(args.front());
+    std::vector<std::string> all{"--profile", profile.string(), "--run", "r1",
+                                 "--replay",  log.string(),     "--fast"};
+    all.insert(all.end(), args.begin(), args.end());
+    const Outcome o = run(Program::Car, all, scratch);
+    EXPECT_EQ(o.exit, 1) << describe(o);
+    EXPECT_NE(o.output.find(profile.string() +
+                            ": 2 models of [[models]] cannot run on this run's channels"),
+              std::string::npos)
+        << describe(o);
+    EXPECT_NE(
+        o.output.find(
+            "models[1] 'lateral_bicycle' needs 'yaw_rate' and 'd_yaw_rate' (the derivative of "
+            "'yaw_rate'), which this run does not have (it would also read 'roll', optional, "
+            "absent too)"),
+        std::string::npos)
+        << describe(o);
+    EXPECT_NE(
+        o.output.find(
+            "models[3] 'kinematic_lateral' needs 'yaw_rate', which this run does not have (it "
+            "would also read 'roll', optional, absent too)"),
+        std::string::npos)
+        << describe(o);
+    EXPECT_LT(o.seconds, 3.0) << describe(o);
+    EXPECT_FALSE(std::filesystem::exists(out)) << "no chunk written";
+    EXPECT_FALSE(std::filesystem::exists(spool)) << "no spool made, nothing sent";
   }
 }
 

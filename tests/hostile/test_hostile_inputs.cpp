@@ -74,11 +74,13 @@ TEST(HostileInputFiles, OnlyRegularFilesOfBoundedSizeAreRead) {
   EXPECT_EQ(input::read_input_file(small, "thing"), "text");
 }
 
-// A line at every length around the bound: read in bounded pieces, each a counted error, the
-// good line after it still read.
-TEST(HostileCandump, LongLinesAreBadInBoundedPiecesAndTheNextLineIsRead) {
+// A line at every length around the bound is one bad line, however long (a junk line of
+// megabytes once counted once per KiB and outvoted a log's frames); the good line after it is
+// read. A file without newlines is read only as far as stop_after_bytes allows.
+TEST(HostileCandump, ALongLineIsOneBadLineAndTheNextLineIsRead) {
   const std::size_t bound = can::CandumpReader::kMaxLineBytes;
-  for (const std::size_t n : {bound - 2, bound - 1, bound, bound + 1, 3 * bound, 100 * bound + 7}) {
+  for (const std::size_t n :
+       {bound - 2, bound - 1, bound, bound + 1, 3 * bound, 100 * bound + 7, 5000 * bound}) {
     SCOPED_TRACE(n);
     std::istringstream in(std::string(n, 'x') + "\n(1700000000.000001) can0 123#00\n");
     can::CandumpReader reader(in, "long.log");
@@ -86,16 +88,25 @@ TEST(HostileCandump, LongLinesAreBadInBoundedPiecesAndTheNextLineIsRead) {
     ASSERT_TRUE(reader.next(f));
     EXPECT_EQ(f.id, 0x123u);
     EXPECT_EQ(reader.line_number(), 2u);
-    EXPECT_GE(reader.error_count(), 1u);
-    EXPECT_LE(reader.error_count(), n / bound + 1);
+    ASSERT_EQ(reader.error_count(), 1u);
+    EXPECT_EQ(reader.errors().front().line, 1u);
+    if (n > bound) {
+      EXPECT_EQ(reader.errors().front().reason,
+                "line of " + std::to_string(n) + " bytes, longer than the " +
+                    std::to_string(bound) + " a line may have: skipped");
+    }
+    EXPECT_FALSE(reader.next(f));
   }
   std::istringstream zeros(std::string(50 * bound, '\0'));
   can::CandumpReader reader(zeros, "zeros.log");
-  reader.stop_after_errors(10);
+  reader.stop_after_bytes(10 * bound);
   can::Frame f;
   EXPECT_FALSE(reader.next(f));
   EXPECT_TRUE(reader.stopped());
-  EXPECT_EQ(reader.error_count(), 10u);
+  EXPECT_EQ(reader.error_count(), 1u);
+  EXPECT_LE(reader.bytes_consumed(), 10 * bound + 1);
+  EXPECT_NE(reader.errors().front().reason.find("reading stopped"), std::string::npos)
+      << reader.errors().front().reason;
 }
 
 // Numbers in request arguments and effect names: the whole text is the number, finite, or none.

@@ -155,5 +155,26 @@ TEST(Effects, AntiRollBarColumnIsTheTravelDifference) {
   }));
 }
 
+// The bicycle model has no longitudinal tyre force (lateral_bicycle.hpp): braking rows, and
+// those within brake_margin of one, are left out of both groups.
+TEST(Effects, LateralBicycleLeavesOutBrakingRows) {
+  model::ChannelSet set(0.1, 6);
+  Eigen::VectorXd pressure(6);
+  pressure << 0, 0, 5e5, 0, 0, 0;
+  for (const char* c : {"vx", "vy"}) set.add(c, "m/s", Eigen::VectorXd::Constant(6, 10.0));
+  set.add("ay", "m/s^2", Eigen::VectorXd::Constant(6, 1.0));
+  set.add("yaw_rate", "rad/s", Eigen::VectorXd::Constant(6, 0.1));
+  set.add("d_yaw_rate", "rad/s^2", Eigen::VectorXd::Constant(6, 0.01));
+  set.add("steer", "rad", Eigen::VectorXd::Constant(6, 0.05));
+  set.add("brake_pressure", "Pa", pressure);
+  const auto lat = model::make_model("lateral_bicycle", {{"a", 1.0}, {"b", 1.5}, {"mass", 1000}});
+  for (const model::GroupRows& g : lat->rows(set))
+    EXPECT_EQ(g.samples, (std::vector<Eigen::Index>{0, 1, 3, 4, 5}));
+  const auto margin = model::make_model(
+      "lateral_bicycle", {{"a", 1.0}, {"b", 1.5}, {"mass", 1000}, {"brake_margin", 0.1}});
+  for (const model::GroupRows& g : margin->rows(set))
+    EXPECT_EQ(g.samples, (std::vector<Eigen::Index>{0, 4, 5}));
+}
+
 }  // namespace
 }  // namespace dynid::test

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "dynid/model/registry.hpp"
 #include "dynid/residual/consistency.hpp"
@@ -165,6 +166,29 @@ TEST(Consistency, AWheelTorqueMeterReadingHighIsFoundAgainstTheWeighedMassNotInT
   EXPECT_NE(f.statement.find("wheel_torque"), std::string::npos) << f.statement;
   // The residual alone cannot tell: the fit rescales and the verdict does not change.
   EXPECT_EQ(high.diagnosis.verdict, right.diagnosis.verdict);
+}
+
+// with_instruments: IV's values and HAC std replace least squares' only where IV replaces least
+// squares on the run (its Durbin-Wu-Hausman test rejects them), and only where both estimate.
+TEST(Consistency, WeighsInstrumentalValuesWhereTheyReplaceLeastSquares) {
+  const ModelParameters ls =
+      fitted("wheel", {"wheel_torque"}, {{"mass", 1448.0}, {"SCx", 0.66}}, 0.002);
+  IvFit iv;
+  iv.parameters = ls.parameters;
+  iv.value = Eigen::Vector2d(1458.0, std::numeric_limits<double>::quiet_NaN());
+  iv.hac_std = Eigen::Vector2d(4.0, 0.01);
+  iv.dwh.rejects = false;  // no evidence of bias: least squares stand
+  const ModelParameters kept = with_instruments(ls, iv);
+  EXPECT_EQ(kept.estimator, "least squares");
+  EXPECT_EQ(kept.value(0), 1448.0);
+  iv.dwh.rejects = true;
+  const ModelParameters replaced = with_instruments(ls, iv);
+  EXPECT_EQ(replaced.estimator, "IV");
+  EXPECT_EQ(replaced.value(0), 1458.0);
+  EXPECT_EQ(replaced.std(0), 4.0);
+  EXPECT_EQ(replaced.value(1), 0.66);  // IV does not estimate it: least squares' value stays
+  iv.refused = true;                   // weak instruments: no IV values
+  EXPECT_EQ(with_instruments(ls, iv).estimator, "least squares");
 }
 
 }  // namespace

@@ -204,6 +204,34 @@ TEST(Materiality, WeighsTheMeanSquareRemovedAgainstTheFloorTestsResolution) {
   EXPECT_TRUE(materiality(declared, reaching).material());
 }
 
+// Structure a better sensor shows at the declared floor (diagnosis.hpp) is weighed like a
+// candidate: its excess over the better sensor's own floor, in units of the declared floor's mean
+// square, against the declared floor test's resolution; below it a note, not a verdict.
+TEST(Materiality, HiddenStructureIsWeighedInTheDeclaredFloorsUnits) {
+  NoiseFloor declared;
+  GroupFloor d;
+  d.group = "longitudinal";
+  d.rows = 1000;
+  d.residual_rms = 108.0;
+  d.floor_rms = 100.0;
+  d.upper_ratio = 1.2;
+  declared.groups = {d};
+  GroupFloor sensor = d;  // the accelerometer's model: far lower floor, far above it
+  sensor.residual_rms = 28.0;
+  sensor.floor_rms = 14.0;
+  const HiddenStructure small = hidden_structure("road_grade_accelerometer", declared, sensor);
+  EXPECT_NEAR(small.share, (28.0 * 28.0 - 14.0 * 14.0) / 1e4, 1e-12);  // 0.0588
+  EXPECT_NEAR(small.resolution, 0.2, 1e-12);
+  EXPECT_FALSE(small.material());
+  EXPECT_NE(small.statement().find("immaterial"), std::string::npos) << small.statement();
+  sensor.residual_rms = 46.0;  // 0.1920: still under what the declared floor resolves
+  EXPECT_FALSE(hidden_structure("s", declared, sensor).material());
+  sensor.residual_rms = 47.0;  // 0.2013
+  EXPECT_TRUE(hidden_structure("s", declared, sensor).material());
+  sensor.group = "yaw";  // no declared floor for it: nothing bounds it
+  EXPECT_TRUE(hidden_structure("s", declared, sensor).material());
+}
+
 TEST(Cancellation, StopsTheLoopsFitsWithTheReasonOnlyWhileInstalled) {
   const auto kin = model::make_model("kinematic_longitudinal", {});
   const auto run = hilly_run(0.05);

@@ -30,6 +30,14 @@ residual::ModelParameters declared_hac(const car::VehicleProfile& profile, const
                                   run.announcement.preprocessing.odmf);
 }
 
+residual::ModelParameters declared_compared(
+    const car::VehicleProfile& profile, const std::string& model, const ingest::RecordedRun& run,
+    const std::vector<ingest::PreprocessedSegment>& segments) {
+  const ingest::ModelSpec spec = model_spec(profile, model);
+  const auto m = model::make_model(spec.model, spec.constants);
+  return residual::compared_parameters(*m, spec.effects, segments, run.announcement);
+}
+
 residual::IvFit declared_iv(const car::VehicleProfile& profile, const std::string& model,
                             const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments) {
   const ingest::ModelSpec spec = model_spec(profile, model);

@@ -179,6 +179,23 @@ RunSources run_profile(const Options& options) {
   return run;
 }
 
+// A model the server could not run on this run's channels is refused before anything is
+// announced, spooled or written: otherwise the whole run streams and only the server says, at
+// its end, "not run: the run has no channel ...".
+void check_models(const Options& options, const VehicleProfile& profile) {
+  const std::vector<std::string> lacking = models_lacking_channels(profile);
+  if (lacking.empty()) return;
+  std::string text =
+      options.profile + ": " +
+      (lacking.size() == 1 ? "a model" : std::to_string(lacking.size()) + " models") +
+      " of [[models]] cannot run on this run's channels: ";
+  for (std::size_t i = 0; i < lacking.size(); ++i) text += (i == 0 ? "" : "; ") + lacking[i];
+  throw dynid::InputError(
+      text +
+      ". Map the channels in [[channels]] (or give the source that has them), or "
+      "remove the model");
+}
+
 // What the run left out: the auxiliary samples outside the bus's time, the samples no chunk may
 // carry, and the channels that made rows invalid, each named.
 void log_left_out(const CarPipeline& pipe) {
@@ -194,8 +211,11 @@ void log_left_out(const CarPipeline& pipe) {
 }
 
 // Lines of a log judged before anything of it is announced, spooled or written: enough to tell
-// a log from another file at once, few enough that the probe costs nothing (about 5 ms).
+// a log from another file at once, few enough that the probe costs nothing (about 5 ms). And the
+// bytes it reads at most: a long line is one bad line however long, so only this bounds the look
+// at a file without newlines (a sparse file); it passes a junk line of 100 MB (0.1 s to skip).
 constexpr std::uint64_t kProbeLines = 10000;
+constexpr std::uint64_t kProbeBytes = 256ull << 20;
 
 // "<file>: <reason>", with the first bad line's reason when there is one.
 std::string log_problem(const Options& options, const LogSource& source, const std::string& problem) {
@@ -206,11 +226,13 @@ std::string log_problem(const Options& options, const LogSource& source, const s
 
 // A file the replay would make nothing of fails here, before any state changes.
 void probe_log(const Options& options, const VehicleProfile& profile) {
-  LogSource source(options.replay, kProbeLines);
+  LogSource source(options.replay, kProbeLines, kProbeBytes);
   const std::string problem = replay_problem(probe(source, profile, kProbeLines));
   if (!problem.empty())
-    throw dynid::InputError(log_problem(options, source, problem + " in its first " + std::to_string(kProbeLines) +
-                                                             " lines"));
+    throw dynid::InputError(log_problem(options, source,
+                                        problem + " in its first " + std::to_string(kProbeLines) +
+                                            " lines (at most " + std::to_string(kProbeBytes >> 20) +
+                                            " MiB)"));
 }
 
 // Replays options.replay into the pipeline (finished at the end); on_progress as ReplayOptions'.
@@ -386,6 +408,7 @@ struct Session {
 int write_chunks(const Options& options) {
   RunSources sources = run_profile(options);
   const VehicleProfile& profile = sources.profile;
+  check_models(options, profile);
   if (!options.replay.empty()) probe_log(options, profile);
   // The source is opened before the chunk file is created: a bus that cannot be read leaves none.
   std::optional<SocketCanSource> live;
@@ -423,6 +446,7 @@ int run(const Options& options, ProgressDisplay& display) {
   const std::string cyclone_config = dynid::dds::config_uri(options.cyclone_config);
   RunSources sources = run_profile(options);
   const VehicleProfile& profile = sources.profile;
+  if (!options.replay.empty() || !options.can.empty()) check_models(options, profile);  // a new run
   if (!options.replay.empty()) probe_log(options, profile);
   const std::filesystem::path spool_dir = options.spool.empty() ? profile.spool_directory : std::filesystem::path(options.spool);
   Spool spool(spool_dir, profile.spool_max_bytes);

@@ -4,10 +4,12 @@
 
 namespace dynid::car {
 
-LogSource::LogSource(const std::filesystem::path& path, std::size_t max_bad) {
+LogSource::LogSource(const std::filesystem::path& path, std::size_t max_bad,
+                     std::uint64_t max_bytes) {
   reader_ = can::open_log(path, can::OnError::Continue);  // checks the path first
   size_ = std::filesystem::file_size(path);
   reader_->stop_after_errors(max_bad);
+  reader_->stop_after_bytes(max_bytes);
 }
 
 NextStatus LogSource::next(can::Frame& frame, std::chrono::milliseconds /*timeout*/) {

@@ -1,12 +1,14 @@
 #include "dynid/car/vehicle_profile.hpp"
 
 #include <cmath>
+#include <functional>
 #include <initializer_list>
 #include <set>
 #include <sstream>
 
 #include <toml++/toml.h>
 
+#include <dynid/ingest/model_channels.hpp>
 #include <dynid/input/ids.hpp>
 #include <dynid/input/input_file.hpp>
 #include <dynid/model/registry.hpp>
@@ -331,6 +333,12 @@ ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml
       r.fail(signals_key(t, key), "unknown DBC signal '" + name + "' in message '" + m.message + "' of " +
                                       p.dbc_path.filename().string(),
              signals_node(t));
+    if (const std::string& never = m.dbc_message->signals[*index].never_present; !never.empty())
+      r.fail(signals_key(t, key),
+             "DBC signal '" + name + "' of message '" + m.message +
+                 "' never gets a value (channel '" + m.channel +
+                 "' would be invalid in every row): " + never,
+             signals_node(t));
     SignalInput in{name, *index, {}, {}};
     in.to_si = input_conversion(r, t, key, m, m.dbc_message->signals[*index], in.dbc_unit);
     m.inputs.push_back(std::move(in));
@@ -616,6 +624,54 @@ ingest::RunAnnouncement VehicleProfile::announcement(const std::string& run) con
   a.models = models;
   a.preprocessing = preprocessing;
   return a;
+}
+
+namespace {
+
+// "'d_yaw_rate' (the derivative of 'yaw_rate')": a derived channel says what it is made from.
+std::string described(const std::vector<std::string>& channels) {
+  std::vector<std::string> out;
+  for (const std::string& c : channels)
+    out.push_back("'" + c + "'" +
+                  (c.rfind("d_", 0) == 0 ? " (the derivative of '" + c.substr(2) + "')" : ""));
+  return listing(out);
+}
+
+// Declared sources not in this run that have one of `channels` (or its base, for a d_<x>).
+std::string sources_hint(const VehicleProfile& p, const std::vector<std::string>& channels,
+                         const std::function<bool(const std::string&)>& provided) {
+  std::vector<std::string> hints;
+  for (const AuxiliarySourceSpec& s : p.sources)
+    for (const SourceChannel& sc : s.channels)
+      for (const std::string& c : channels)
+        if ((c == sc.channel || c == "d_" + sc.channel) && !provided(sc.channel)) {
+          hints.push_back("source '" + s.name + "' has '" + sc.channel + "' (--source " + s.name +
+                          "=FILE)");
+          break;
+        }
+  return hints.empty() ? "" : "; " + listing(hints);
+}
+
+}  // namespace
+
+std::vector<std::string> models_lacking_channels(const VehicleProfile& p) {
+  const ingest::RunAnnouncement run = p.announcement("r");
+  const std::function<bool(const std::string&)> provided = [&](const std::string& c) {
+    return ingest::run_provides(run, c);
+  };
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < p.models.size(); ++i) {
+    const ingest::ModelSpec& spec = p.models[i];
+    const ingest::ChannelGaps gaps =
+        ingest::channel_gaps(*model::make_model(spec.model, spec.constants), spec, provided);
+    if (gaps.missing.empty()) continue;
+    std::string line = "models[" + std::to_string(i) + "] '" + spec.model + "' needs " +
+                       described(gaps.missing) + ", which this run does not have";
+    if (!gaps.optional_absent.empty())
+      line += " (it would also read " + described(gaps.optional_absent) + ", optional, absent too)";
+    out.push_back(line + sources_hint(p, gaps.missing, provided));
+  }
+  return out;
 }
 
 VehicleProfile parse_vehicle_profile(std::string_view text, const std::filesystem::path& source) {

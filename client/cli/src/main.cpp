@@ -8,9 +8,10 @@
 // what the missing shards hold is left out, said on stderr, and the exit code is 6.
 //
 // Exit codes: 0 ok, 2 bad request (or bad command line: a number outside its limits, a vehicle
-// id or run name that breaks the id rule of dynid/input/ids.hpp), 3 not found, 4 the server failed (or
-// the servers disagree on the shard count), 5 no server answered in time, 6 some shards did
-// not answer (the output holds the others').
+// id or run name that breaks the id rule of dynid/input/ids.hpp), 3 not found, 4 the server failed
+// (or the servers disagree on the shard count), 5 no server answered in time, 6 some shards did not
+// answer (the output holds the others'), 7 no DDS participant index was free on this host (other
+// DDS programs hold them all: retried for about 7 s first).
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -26,6 +27,7 @@
 #include "dynid/cli/shard_replies.hpp"
 #include "dynid/cli/watch_view.hpp"
 #include "dynid/dds/conversions.hpp"
+#include "dynid/dds/participant.hpp"
 #include "dynid/dds/protocol.hpp"
 #include "dynid/dds/topics.hpp"
 #include "dynid/report/estimate_report.hpp"
@@ -46,6 +48,17 @@ struct Common {
   double timeout_s = 10.0;
   bool json = false;
 };
+
+// A request is cheap to repeat, and a storm of them (a script starting many at once) may hold
+// every participant index of the host for a moment: the creation is retried, for up to about
+// 7 s (participant.hpp), before the CLI gives up with exit 7.
+constexpr int kParticipantAttempts = 8;
+
+dynid::dds::ParticipantOptions participant_options(const Common& c) {
+  dynid::dds::ParticipantOptions o{c.domain, dynid::dds::config_uri(c.config)};
+  o.index_attempts = kParticipantAttempts;
+  return o;
+}
 
 int exit_code(dynid::dds::ReplyStatus status) {
   switch (status) {
@@ -104,7 +117,7 @@ void check_against_protocol(const std::string& kind,
 
 int request(const Common& c, const std::string& kind, std::vector<RequestArgument> arguments) {
   check_against_protocol(kind, arguments);
-  dynid::dds::Participant participant({c.domain, dynid::dds::config_uri(c.config)});
+  dynid::dds::Participant participant(participant_options(c));
   dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
   if (kind == "vehicles" || kind == "status") return request_all(c, client, kind);
   if (c.json) arguments.push_back({"format", "json"});
@@ -116,7 +129,7 @@ int report_request(const Common& c, const std::string& kind, const std::vector<R
                    const std::string& html_file) {
   if (html_file.empty()) return request(c, kind, arguments);
   check_against_protocol(kind, arguments);
-  dynid::dds::Participant participant({c.domain, dynid::dds::config_uri(c.config)});
+  dynid::dds::Participant participant(participant_options(c));
   dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
   const dynid::dds::Reply reply = client.call(kind, arguments, timeout_of(c));
   if (reply.status != dynid::dds::ReplyStatus::kOk) return print(kind, reply);
@@ -134,7 +147,7 @@ int report_request(const Common& c, const std::string& kind, const std::vector<R
 // that model only, compact (WatchView): redrawn in place on a terminal, appended blocks on a
 // pipe or file, JSON lines with --json.
 int watch(const Common& c, const std::string& vehicle, const std::string& model, double seconds) {
-  dynid::dds::Participant participant({c.domain, dynid::dds::config_uri(c.config)});
+  dynid::dds::Participant participant(participant_options(c));
   dynid::dds::Reader<dynid_wire_Estimate> reader(participant, {dynid::dds::vehicle_partition(vehicle)});
   const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long long>(seconds * 1000));
   const bool terminal = isatty(STDOUT_FILENO) == 1;
@@ -197,8 +210,11 @@ int main(int argc, char** argv) {
   CLI::App app{"dynid: vehicles, runs and parameter estimates from dynid-server"};
   app.require_subcommand(1);
   app.fallthrough();  // --json and the connection options may also follow the subcommand
-  app.add_option("--cyclone-config", c.config,
-                 "Cyclone DDS configuration: file, file:// URI or XML (or $DYNID_CYCLONE_CONFIG)");
+  app.add_option(
+      "--cyclone-config", c.config,
+      "Cyclone DDS configuration: file, file:// URI or XML (or $DYNID_CYCLONE_CONFIG). When "
+      "other DDS programs hold every participant index it allows, joining is retried for up "
+      "to about 7 s, then exit 7");
   app.add_option("--domain", c.domain, "DDS domain id")->check(dynid::input::within(0, 230));
   auto* timeout = app.add_option("--timeout", c.timeout_s,
                                  "seconds to wait for the server (default 10; 120 for residual, add-effect, trace, consistency, iv)")
@@ -389,6 +405,9 @@ int main(int argc, char** argv) {
   } catch (const dynid::cli::ShardMismatch& e) {
     std::cerr << "dynid: " << e.what() << "\n";
     return 4;
+  } catch (const dynid::dds::NoParticipantIndex& e) {
+    std::cerr << "dynid: " << e.what() << "\n";
+    return 7;
   } catch (const std::exception& e) {
     std::cerr << "dynid: " << e.what() << "\n";
     return 2;

@@ -7,8 +7,8 @@
 #include "byte_codec.hpp"
 #include "derived_channels.hpp"
 #include "dynid/error.hpp"
+#include "dynid/ingest/model_channels.hpp"
 #include "dynid/model/channel_set.hpp"
-#include "dynid/model/effects.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/signal/butterworth.hpp"
 #include "segment_stream.hpp"
@@ -34,35 +34,6 @@ struct FoldJob {
   std::size_t model;
   std::vector<model::GroupRows> rows;
 };
-
-// Every channel a model reads: its own, and the enabled effects'.
-std::vector<std::string> channels_read(const model::Model& m, const ModelSpec& spec) {
-  std::vector<std::string> out;
-  for (const model::ChannelNeed& need : m.channels()) out.push_back(need.name);
-  const std::vector<model::Effect> own = m.candidate_effects();
-  for (const std::string& e : spec.effects) {
-    const auto it =
-        std::find_if(own.begin(), own.end(), [&](const model::Effect& x) { return x.name == e; });
-    if (it != own.end())
-      out.insert(out.end(), it->channels.begin(), it->channels.end());
-    else if (model::is_dictionary_effect(e))
-      for (const std::string& c : model::dictionary_effect(e, m.groups()).channels)
-        out.push_back(c);
-  }
-  return out;
-}
-
-// Channels the model cannot do without (its required ones, the enabled effects') absent from set.
-std::string missing_channels(const model::Model& m, const ModelSpec& spec,
-                             const model::ChannelSet& set) {
-  std::vector<std::string> needed = channels_read(m, spec);
-  for (const model::ChannelNeed& need : m.channels())
-    if (need.optional) needed.erase(std::find(needed.begin(), needed.end(), need.name));
-  std::string missing;
-  for (const std::string& c : needed)
-    if (!set.has(c)) missing += (missing.empty() ? "'" : ", '") + c + "'";
-  return missing;
-}
 
 // The checksum of the announcement's encoding (its trailer). Not the CRC of the whole encoding:
 // a CRC over data followed by its own CRC is the same constant for every input.
@@ -176,9 +147,10 @@ void RunProcessor::Impl::plan_models() {
     run.spec = announcement.models[i];
     run.group_names = built[i]->groups();
     run.parameters = built[i]->parameters_with(run.spec.effects);
-    const std::string missing = missing_channels(*built[i], run.spec, probe);
-    if (!missing.empty()) {
-      run.note = "not run: the run has no channel " + missing;
+    const ChannelGaps gaps =
+        channel_gaps(*built[i], run.spec, [&](const std::string& c) { return probe.has(c); });
+    if (!gaps.missing.empty()) {
+      run.note = "not run: the run has no channel " + quoted_list(gaps.missing);
     } else {
       (void)built[i]->rows(probe, run.spec.effects);  // throws on a wrong unit or effect
       run.groups.emplace(static_cast<Eigen::Index>(run.parameters.size()), run.group_names);

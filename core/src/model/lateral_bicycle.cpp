@@ -1,5 +1,6 @@
 #include "dynid/model/lateral_bicycle.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "dynid/model/effects.hpp"
@@ -20,6 +21,9 @@ LateralBicycleModel::LateralBicycleModel(const Constants& constants) {
   imu_x_ = c.optional("imu_x").value_or(0.0);
   min_speed_ = c.positive_or("min_speed", 1.0);
   gravity_ = c.positive_or("gravity", detail::kStandardGravity);
+  brake_threshold_ = c.positive_or("brake_pressure_threshold", 2e4);
+  brake_margin_ = c.optional("brake_margin").value_or(0.0);
+  if (brake_margin_ < 0.0) brake_margin_ = c.positive("brake_margin", "s, >= 0");
 }
 
 ParameterInfo LateralBicycleModel::scaled(ParameterInfo p) const {
@@ -47,9 +51,23 @@ std::vector<ParameterInfo> LateralBicycleModel::parameters() const {
 }
 
 std::vector<ChannelNeed> LateralBicycleModel::channels() const {
-  return {{"vx", "m/s"},         {"vy", "m/s"},           {"ay", "m/s^2"},
-          {"yaw_rate", "rad/s"}, {"d_yaw_rate", "rad/s^2"}, {"steer", "rad"},
-          {"roll", "rad", true}, {"az", "m/s^2", true}};
+  return {{"vx", "m/s"},
+          {"vy", "m/s"},
+          {"ay", "m/s^2"},
+          {"yaw_rate", "rad/s"},
+          {"d_yaw_rate", "rad/s^2"},
+          {"steer", "rad"},
+          {"roll", "rad", true},
+          {"az", "m/s^2", true},
+          {"brake_pressure", "Pa", true}};
+}
+
+RowReach LateralBicycleModel::reach(double sample_period) const {
+  RowReach r = Model::reach(sample_period);
+  const Eigen::Index brake = detail::margin_samples(brake_margin_, sample_period);
+  r.back = std::max(r.back, brake);
+  r.ahead = std::max(r.ahead, brake);
+  return r;
 }
 
 std::function<double(Eigen::Index)> LateralBicycleModel::road_plane_ay(const ChannelSet& set) const {
@@ -145,9 +163,14 @@ RowModel::RowFn LateralBicycleModel::bind(const ChannelSet& set,
   const Eigen::VectorXd& vx = set["vx"];
   const Eigen::VectorXd& dr = set["d_yaw_rate"];
   const double scale = mass_.value_or(1.0);
-  return [=, this, &vx, &dr, ay = road_plane_ay(set), s = slip(set)](Eigen::Index k, std::size_t group, double* w,
-                                                  double& y) {
-    if (vx(k) < min_speed_) return false;
+  // Braking rows and those within brake_margin of one (the header says why; the low-pass spreads
+  // the brake force's step as in the longitudinal model).
+  const std::vector<bool> braking = detail::within_margin_of(
+      set.samples(), detail::margin_samples(brake_margin_, set.sample_period()),
+      detail::braking(set, brake_threshold_, false));
+  return [=, this, &vx, &dr, ay = road_plane_ay(set), s = slip(set)](
+             Eigen::Index k, std::size_t group, double* w, double& y) {
+    if (vx(k) < min_speed_ || braking[static_cast<std::size_t>(k)]) return false;
     const Slip v = s(k);
     if (group == 0) {
       w[1] = v.front * v.cos_steer;

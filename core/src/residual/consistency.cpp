@@ -8,6 +8,7 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
 
+#include "dynid/error.hpp"
 #include "dynid/model/parameter_status.hpp"
 #include "folded_rows.hpp"
 #include "hac_wald.hpp"
@@ -54,7 +55,7 @@ std::size_t measuring(const ModelParameters& m, const std::string& quantity,
 
 ParameterAgreement compare(const std::string& parameter, const std::string& unit, const std::string& first, double a,
                            double sa, const std::string& second, double b, double sb) {
-  ParameterAgreement out{parameter, unit, first, second, a, sa, b, sb};
+  ParameterAgreement out{parameter, unit, first, second, {}, {}, a, sa, b, sb};
   const double s = std::sqrt(sa * sa + sb * sb);
   out.z = s > 0.0 ? (a - b) / s : (a == b ? 0.0 : std::numeric_limits<double>::infinity());
   out.p_value = std::isfinite(out.z) ? 2.0 * boost::math::cdf(boost::math::complement(boost::math::normal(), std::abs(out.z))) : 0.0;
@@ -74,11 +75,16 @@ std::vector<ParameterAgreement> comparisons_of(const std::vector<ModelParameters
       // locked driveline's J_e + J_in).
       for (std::size_t k = i + 1; k < models.size() && !p.quantity.empty(); ++k) {
         double b = 0.0, sb = 0.0;
-        if (lookup(models[k], measuring(models[k], p.quantity, p.unit), b, sb))
+        if (lookup(models[k], measuring(models[k], p.quantity, p.unit), b, sb)) {
           out.push_back(compare(p.name, p.unit, models[i].model, a, sa, models[k].model, b, sb));
+          out.back().first_estimator = models[i].estimator;
+          out.back().second_estimator = models[k].estimator;
+        }
       }
-      if (const auto r = reference.find(p.reference_key()); r != reference.end())
+      if (const auto r = reference.find(p.reference_key()); r != reference.end()) {
         out.push_back(compare(p.name, p.unit, models[i].model, a, sa, kReference, r->second, 0.0));
+        out.back().first_estimator = models[i].estimator;
+      }
     }
   }
   return out;
@@ -191,6 +197,34 @@ ModelParameters hac_parameters(const model::Model& model, const std::vector<std:
   ModelParameters out{model.name(), model.measured_side(), rows.parameters, fit.all.value,
                       hac.stds.size() == width ? hac.stds : Eigen::VectorXd::Constant(width, kNaN)};
   return out;
+}
+
+ModelParameters with_instruments(ModelParameters ls, const IvFit& iv) {
+  const auto n = ls.value.size();
+  if (!iv.replaces_least_squares() || iv.value.size() != n || iv.hac_std.size() != n ||
+      iv.parameters.size() != ls.parameters.size())
+    return ls;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (std::isfinite(ls.value(i)) && std::isfinite(iv.value(i)) && std::isfinite(iv.hac_std(i)))
+      ls.value(i) = iv.value(i), ls.std(i) = iv.hac_std(i);
+  ls.estimator = "IV";
+  return ls;
+}
+
+ModelParameters compared_parameters(const model::Model& model,
+                                    const std::vector<std::string>& effects,
+                                    const std::vector<ingest::PreprocessedSegment>& run,
+                                    const ingest::RunAnnouncement& announcement) {
+  const double rate = announcement.sample_rate_hz;
+  const int odmf = announcement.preprocessing.odmf;
+  ModelParameters ls = hac_parameters(model, effects, run, rate, odmf);
+  IvOptions options;
+  options.preprocessing = announcement.preprocessing;
+  try {
+    return with_instruments(std::move(ls), iv_fit(model, effects, run, rate, odmf, options));
+  } catch (const InputError&) {
+    return ls;  // no IV fit of these rows: least squares' values are the published ones
+  }
 }
 
 bool Consistency::consistent() const {

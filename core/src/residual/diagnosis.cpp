@@ -455,6 +455,39 @@ Materiality materiality(const NoiseFloor& declared, const NoiseFloor& extended) 
   return out;
 }
 
+HiddenStructure hidden_structure(const std::string& sensor, const NoiseFloor& declared,
+                                 const GroupFloor& extended) {
+  HiddenStructure out{sensor, extended.group, extended.residual_rms, extended.floor_rms, 0.0, 0.0};
+  const auto d = std::find_if(declared.groups.begin(), declared.groups.end(),
+                              [&](const GroupFloor& g) { return g.group == extended.group; });
+  // Without the declared group's floor nothing bounds it: material, the verdict says it.
+  if (d == declared.groups.end() || !(d->floor_rms > 0.0)) {
+    out.share = std::numeric_limits<double>::infinity();
+    return out;
+  }
+  out.share =
+      (extended.residual_rms * extended.residual_rms - extended.floor_rms * extended.floor_rms) /
+      (d->floor_rms * d->floor_rms);
+  out.resolution = d->upper_ratio - 1.0;
+  return out;
+}
+
+std::string HiddenStructure::statement() const {
+  char buf[400];
+  std::snprintf(
+      buf, sizeof buf,
+      "with %s (a better sensor of a declared signal) the %s residual shows structure the declared "
+      "signals' noise hides: RMS %.4g against that model's floor %.4g, %.3g of the declared "
+      "floor's mean "
+      "square, %s the %.3g the floor test resolves",
+      sensor.c_str(), group.c_str(), residual_rms, floor_rms, share,
+      material() ? "at least" : "less than", resolution);
+  return std::string(buf) + (material()
+                                 ? ""
+                                 : ": immaterial by that measure, a note (no candidate expresses "
+                                   "it, so nothing says which parameter it would move)");
+}
+
 const char* verdict_name(Verdict verdict) {
   switch (verdict) {
     case Verdict::kAdequate: return "adequate";
@@ -503,6 +536,7 @@ std::string Diagnosis::verdict_statement() const {
   switch (verdict) {
     case Verdict::kAdequate: {
       out = "adequate: the residual of " + screen.fit.model + " is at the noise floor (" + floors + ")";
+      if (hidden) out += "; note: " + hidden->statement();
       if (const CandidateScore* b = screen.best())
         out += "; " + b->effect +
                " is significant all the same: at the floor it can only be fitting the regressors' noise "
@@ -577,7 +611,12 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
     // would accept, when its model stays above its own floor.
     Diagnosis probe = d;
     accept_best(probe, floor_inputs, /*at_floor=*/true);
-    if (!(probe.accepted && probe.partial)) {
+    if (probe.accepted && probe.partial)
+      if (HiddenStructure hidden =
+              hidden_structure(probe.accepted->effect, d.floor, *probe.partial);
+          !hidden.material())
+        d.hidden = std::move(hidden);
+    if (!(probe.accepted && probe.partial) || d.hidden) {
       d.verdict = Verdict::kAdequate;
       d.inseparable = inseparable_effects(model, d.screen);
       d.signature = signature_of(signature_inputs(model, segments, d, rate, odmf, options), options);

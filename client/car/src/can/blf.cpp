@@ -271,7 +271,7 @@ int BlfReader::parse_inner(Frame& f) {
 
 bool BlfReader::next(Frame& frame) {
   if (!header_read_) read_header();
-  while (!stopped_ && !ended_) {
+  while (!stopped_ && !ended_ && byte_budget() > 0) {
     const int r = parse_inner(frame);
     if (r == 1) {
       ++frame_count_;

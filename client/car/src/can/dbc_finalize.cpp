@@ -31,6 +31,7 @@ class MessageChecker {
     for (std::size_t i = 0; i < m_.signals.size(); ++i) link_multiplexer(i);
     check_repeated_names();
     order_for_decoding();
+    for (const std::size_t i : m_.decode_order) check_presence(i);  // switches first
     const auto format = attribute_value(db_, m_.attributes, "VFrameFormat");
     const auto* name = format ? std::get_if<std::string>(&*format) : nullptr;
     m_.fd = m_.size > Frame::kMaxClassicData ||
@@ -100,16 +101,16 @@ class MessageChecker {
 
   void check_layout(std::size_t i) {
     const Signal& s = m_.signals[i];
-    if (s.length < 1 || s.length > 64) fail(i, "length " + std::to_string(s.length) +
-                                                   " is outside 1..64 bits");
+    if (s.length < 1 || s.length > 64)
+      fail(i, "length " + std::to_string(s.length) + " is outside 1..64 bits");
     if (s.value_type == ValueType::Float32 && s.length != 32)
-      fail(i, "a float signal (SIG_VALTYPE_ 1) must be 32 bits long, not " +
-                  std::to_string(s.length));
+      fail(i,
+           "a float signal (SIG_VALTYPE_ 1) must be 32 bits long, not " + std::to_string(s.length));
     if (s.value_type == ValueType::Float64 && s.length != 64)
       fail(i, "a double signal (SIG_VALTYPE_ 2) must be 64 bits long, not " +
                   std::to_string(s.length));
-    if (s.start_bit >= kMaxBits) fail(i, "start bit " + std::to_string(s.start_bit) +
-                                             " is beyond 64 bytes");
+    if (s.start_bit >= kMaxBits)
+      fail(i, "start bit " + std::to_string(s.start_bit) + " is beyond 64 bytes");
     const ByteSpan span = signal_bytes(s);
     if (span.last >= 64 || (s.byte_order == ByteOrder::Intel && s.start_bit + s.length > kMaxBits))
       fail(i, "bits run past byte 64 (start " + std::to_string(s.start_bit) + ", length " +
@@ -121,8 +122,10 @@ class MessageChecker {
   void link_multiplexer(std::size_t i) {
     Signal& s = m_.signals[i];
     if (!s.is_multiplexed()) {
-      if (!s.multiplexer.empty()) fail(i, "SG_MUL_VAL_ names a switch but the signal has no "
-                                          "multiplexer indicator (m<value>)");
+      if (!s.multiplexer.empty())
+        fail(i,
+             "SG_MUL_VAL_ names a switch but the signal has no "
+             "multiplexer indicator (m<value>)");
       return;
     }
     if (s.multiplexer.empty()) s.multiplexer = plain_switch(i);
@@ -147,8 +150,9 @@ class MessageChecker {
                     "') and no SG_MUL_VAL_ says which one selects this signal");
       found = s.name;
     }
-    if (found.empty()) fail(i, "multiplexed (m" + std::to_string(*m_.signals[i].mux_value) +
-                                   ") but message '" + m_.name + "' has no switch signal (M)");
+    if (found.empty())
+      fail(i, "multiplexed (m" + std::to_string(*m_.signals[i].mux_value) + ") but message '" +
+                  m_.name + "' has no switch signal (M)");
     return found;
   }
 
@@ -166,6 +170,43 @@ class MessageChecker {
     if (sw >= 0) visit(static_cast<std::size_t>(sw));
     state_[i] = 2;
     m_.decode_order.push_back(i);
+  }
+
+  // A multiplexed signal whose switch cannot hold any of its values is in no frame: a profile
+  // mapping it would get no sample, ever (every row of its channel invalid, silently).
+  void check_presence(std::size_t i) {
+    Signal& s = m_.signals[i];
+    s.never_present.clear();
+    if (s.multiplexer_index < 0) return;
+    const Signal& sw = m_.signals[static_cast<std::size_t>(s.multiplexer_index)];
+    std::string why;
+    if (!sw.never_present.empty())
+      why = "its switch '" + sw.name + "' is never present itself (line " +
+            std::to_string(sw.line) + ")";
+    else if (sw.value_type != ValueType::Integer)
+      why = "its switch '" + sw.name +
+            "' is a float signal (SIG_VALTYPE_), which selects by no value";
+    else if (sw.length < 64 && !reachable(s, (std::uint64_t{1} << sw.length) - 1))
+      why = "multiplexer " + mux_values(s) + " beyond what its switch '" + sw.name + "' (" +
+            std::to_string(sw.length) + " bits, 0.." +
+            std::to_string((std::uint64_t{1} << sw.length) - 1) + ") can hold";
+    if (why.empty()) return;
+    s.never_present = where(db_, s.line) + "SG_ '" + s.name + "' of message '" + m_.name +
+                      "' is in no frame: " + why;
+    warnings_.push_back(s.never_present);
+  }
+  static bool reachable(const Signal& s, std::uint64_t highest) {
+    return std::any_of(s.mux_ranges.begin(), s.mux_ranges.end(),
+                       [highest](const MuxRange& r) { return r.low <= highest; });
+  }
+  // "value 300", "values 300..310, 400".
+  static std::string mux_values(const Signal& s) {
+    std::string out;
+    for (const MuxRange& r : s.mux_ranges)
+      out += (out.empty() ? "" : ", ") + std::to_string(r.low) +
+             (r.high == r.low ? "" : ".." + std::to_string(r.high));
+    const bool one = s.mux_ranges.size() == 1 && s.mux_ranges[0].low == s.mux_ranges[0].high;
+    return (one ? "value " : "values ") + out + (one ? " is" : " are");
   }
 
   Database& db_;
@@ -208,11 +249,13 @@ std::string set_message_id(Message& m, std::uint32_t raw_id) {
     m.is_pseudo = true;
     m.id = 0;
     if (raw_id == kPseudoMessageId || raw_id == (kPseudoMessageId & ~kDbcExtendedFlag)) return {};
-    return "id " + std::to_string(raw_id) + " has more than 29 bits: kept as a pseudo message "
+    return "id " + std::to_string(raw_id) +
+           " has more than 29 bits: kept as a pseudo message "
            "that no frame can address";
   }
   if (key != raw_id)
-    return "id " + std::to_string(raw_id) + " exceeds 11 bits without the extended flag "
+    return "id " + std::to_string(raw_id) +
+           " exceeds 11 bits without the extended flag "
            "(bit 31): taken as a 29-bit id";
   return {};
 }

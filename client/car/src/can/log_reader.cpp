@@ -1,5 +1,6 @@
 #include <dynid/can/log_reader.hpp>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 
@@ -59,6 +60,13 @@ void LogReader::record_error(std::size_t where, std::string reason) {
   stopped_ = stopped_ || on_error_ == OnError::Stop || error_count_ >= max_errors_;
 }
 
+std::uint64_t LogReader::byte_budget() {
+  const std::uint64_t read = bytes_consumed();
+  if (read < max_bytes_) return max_bytes_ - read;
+  stopped_ = true;
+  return 0;
+}
+
 // Checked before opening: opening a FIFO would block until a writer appears.
 std::unique_ptr<std::ifstream> LogReader::open_file(const std::filesystem::path& path, std::string_view what) {
   input::check_input_file(path, what);
@@ -77,32 +85,57 @@ LineLogReader::LineLogReader(const std::filesystem::path& path, std::string_view
       in_(file_.get()),
       max_line_bytes_(max_line_bytes) {}
 
-// getline with a bound. `too_long`: this piece is (part of) a line of max_line_bytes_ or more;
-// `continued`: it is not the start of its line.
-bool LineLogReader::read_line(bool& too_long, bool& continued) {
-  continued = in_long_line_;
+// getline with a bound: false at the end of the input. `too_long`: the line has
+// more than max_line_bytes_ (its first piece is in buffer_, the rest still to read).
+bool LineLogReader::read_line(bool& too_long) {
   buffer_.resize(max_line_bytes_ + 1);
   in_->getline(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
   const auto got = static_cast<std::size_t>(in_->gcount());
   bytes_ += got;
   if (got == 0 && in_->fail()) return false;  // nothing left
   const bool delimited = !in_->fail() && !in_->eof();  // the '\n' was extracted and counted
-  in_long_line_ = in_->fail() && !in_->eof();       // the buffer filled before a '\n'
-  if (in_long_line_) in_->clear();
-  too_long = continued || in_long_line_;
+  too_long = in_->fail() && !in_->eof();               // the buffer filled before a '\n'
+  if (too_long) in_->clear();
   buffer_.resize(delimited ? got - 1 : got);
   return true;
 }
 
+// The rest of a too-long line, read up to its '\n' (or the end of the input, or the byte
+// budget) in pieces and dropped: one bad line, whatever its length (a 100 MB line of junk in a
+// good log once counted as 100,000 bad lines and outvoted the log's frames). Returns the reason.
+std::string LineLogReader::skip_long_line() {
+  constexpr std::streamsize kPiece = 1 << 16;
+  std::uint64_t length = buffer_.size();
+  std::vector<char> piece(static_cast<std::size_t>(kPiece));
+  for (;;) {
+    const std::uint64_t budget = byte_budget();
+    if (budget == 0)
+      return "line longer than " + std::to_string(max_line_bytes_) + " bytes (reading stopped " +
+             std::to_string(length) + " bytes into it)";
+    // getline stores a '\0' after at most size - 1 bytes: size - 1 is what may still be read.
+    const auto size = static_cast<std::streamsize>(std::min<std::uint64_t>(budget, kPiece - 1) + 1);
+    in_->getline(piece.data(), size);
+    const auto got = static_cast<std::uint64_t>(in_->gcount());
+    bytes_ += got;
+    const bool delimited = !in_->fail() && !in_->eof();
+    if (in_->fail() && !in_->eof()) {
+      in_->clear();  // the piece filled before a '\n': the line goes on
+      length += got;
+      continue;
+    }
+    length += delimited ? got - 1 : got;  // else the line ends with the input
+    return "line of " + std::to_string(length) + " bytes, longer than the " +
+           std::to_string(max_line_bytes_) + " a line may have: skipped";
+  }
+}
+
 bool LineLogReader::next(Frame& frame) {
   bool too_long = false;
-  bool continued = false;
-  while (!stopped_ && read_line(too_long, continued)) {
-    if (!continued) ++line_;
+  while (!stopped_ && byte_budget() > 0 && read_line(too_long)) {
+    ++line_;
     if (!too_long && detail::trim(buffer_).empty()) continue;
     bool is_frame = false;
-    std::string reason = too_long ? "line longer than " + std::to_string(max_line_bytes_) + " bytes"
-                                  : parse_line(buffer_, frame, is_frame);
+    std::string reason = too_long ? skip_long_line() : parse_line(buffer_, frame, is_frame);
     if (!reason.empty()) {
       record_error(line_, std::move(reason));
       continue;

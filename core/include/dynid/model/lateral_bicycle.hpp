@@ -9,7 +9,8 @@
 //
 // ay is the accelerometer (specific force): M ay is the tyre force whatever the road bank, so
 // no grade/bank term appears; an IMU imu_x ahead of the CG reads ay + imu_x dr/dt, removed.
-// The front longitudinal force term F_xf sin(steer) is neglected (small steer: measured 0.2 %).
+// The front longitudinal force term F_xf sin(steer) is neglected where the car does not brake
+// (small steer and drive force: measured 0.2 %; braking rows are left out, below).
 // Roll: a body-fixed accelerometer on a body rolled by phi reads ay cos(phi) + az sin(phi), i.e.
 // g phi more than the road-plane ay. With a roll gradient of ~0.006 rad per m/s^2 that is ~6 % of
 // ay, all of it a scale error on C_f, C_r and J (found on the reference simulator: +6..8 % with
@@ -25,8 +26,16 @@
 // homogeneous in (M, J, C_f, C_r) (venture §10): the model then identifies the same quantities
 // per unit mass (names suffixed _per_mass), with y = ay.
 //
-// Rows left out: vx < min_speed (slip angles undefined). Constants: a, b (m, CG to front and
-// rear axle); optional mass (kg), imu_x (m, 0), min_speed (m/s, 1).
+// Rows left out: vx < min_speed (slip angles undefined); braking (brake_pressure >
+// brake_pressure_threshold, and within brake_margin of it), because the model has no
+// longitudinal tyre force: braked front wheels turned by the steer push the car sideways by
+// F_xf sin(steer) and turn it by a F_xf sin(steer), and the load the braking moves forward
+// changes both axles' cornering stiffness (on an independent car's steering run with the speed
+// cycled by throttle and brakes, F_xf sin(steer) at 2.5 m/s^2 and 2-3 deg of steer is about 3 %
+// of the tyre forces: the yaw residual stood 10-25 % above its noise floor, correlated with the
+// brake pressure). Constants: a, b (m, CG to front and rear axle); optional mass (kg), imu_x
+// (m, 0), min_speed (m/s, 1), brake_pressure_threshold (Pa, 2e4) and brake_margin (s, 0) as the
+// longitudinal model's (longitudinal.hpp).
 // Effects: steer_offset (an offset d0 on the steer sensor: a force C_f d0), slip_offset
 // (constant slip-angle offsets e_f, e_r on both axles: forces C_f e_f, C_r e_r; at a steady speed
 // the steer, vy and yaw-rate sensor offsets all shift the slip angles by constants, and a few
@@ -63,6 +72,7 @@ class LateralBicycleModel final : public RowModel {
  protected:
   std::vector<EffectDefinition> effect_definitions() const override;
   RowFn bind(const ChannelSet& channels, const std::vector<std::string>& effects) const override;
+  RowReach reach(double sample_period) const override;
 
  private:
   struct Slip {
@@ -88,6 +98,8 @@ class LateralBicycleModel final : public RowModel {
   double imu_x_;
   double min_speed_;
   double gravity_;
+  double brake_threshold_;
+  double brake_margin_;
 };
 
 }  // namespace dynid::model

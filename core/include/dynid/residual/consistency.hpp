@@ -23,6 +23,13 @@
 // are low-passed and decimated, and DYCARO's sigma^2 (W'W)^-1 counts every row as independent,
 // which would call a 1 % difference of two honest fits significant.
 //
+// The values are the published estimator's where it is instrumental variables (publication.hpp,
+// rule 1: IV replaces least squares when its Durbin-Wu-Hausman test rejects them), with IV's HAC
+// std (with_instruments). Least squares' errors-in-variables bias (a noisy differentiated wheel
+// speed in a column) differs between two models of one run, whose rows and noisy columns differ,
+// so two honest least-squares fits disagree by it: measured on an independent car, the wheel-
+// and engine-torque models' masses 1 % apart (z = 3-9) on every acceleration and launch run.
+//
 // Traced to a scale: when models disagree and every parameter they share disagrees by one
 // common ratio (the log-ratios' homogeneity chi-square test does not reject at the same level),
 // the disagreement has the signature of a scale error of one model's measured side (its torque
@@ -36,6 +43,7 @@
 
 #include "dynid/ingest/recorded_run.hpp"
 #include "dynid/model/model.hpp"
+#include "dynid/residual/iv_fit.hpp"
 #include "dynid/residual/model_fit.hpp"
 
 namespace dynid::residual {
@@ -47,6 +55,7 @@ struct ModelParameters {
   std::vector<model::ParameterInfo> parameters;
   Eigen::VectorXd value;  ///< NaN: not identifiable
   Eigen::VectorXd std;    ///< HAC; NaN where the value is
+  std::string estimator = "least squares";  ///< or "IV" (with_instruments)
 };
 
 /// `model` with `effects` fitted on `run` (preprocessed segments), with HAC standard deviations.
@@ -55,6 +64,21 @@ ModelParameters hac_parameters(const model::Model& model, const std::vector<std:
                                const std::vector<ingest::PreprocessedSegment>& run, double sample_rate_hz,
                                int odmf, const FitOptions& options = {});
 
+/// `ls` with `iv`'s values and HAC std on every parameter both estimate, when `iv` is a fit of
+/// the same columns that replaces least squares (IvFit::replaces_least_squares); else `ls`
+/// unchanged.
+ModelParameters with_instruments(ModelParameters ls, const IvFit& iv);
+
+/// What the check weighs for `model` with `effects` on `run` (preprocessed segments of the run
+/// `announcement` announces): hac_parameters, with IV's values where IV replaces least squares
+/// (with_instruments; where no IV fit of these rows can be made, least squares'). The one home of
+/// that choice: the server's consistency request and bench/trace call it. InputError as
+/// hac_parameters.
+ModelParameters compared_parameters(const model::Model& model,
+                                    const std::vector<std::string>& effects,
+                                    const std::vector<ingest::PreprocessedSegment>& run,
+                                    const ingest::RunAnnouncement& announcement);
+
 inline constexpr const char* kReference = "reference";
 
 struct ParameterAgreement {
@@ -62,6 +86,8 @@ struct ParameterAgreement {
   std::string unit;
   std::string first;   ///< a model
   std::string second;  ///< another model, or kReference
+  std::string first_estimator,
+      second_estimator;  ///< ModelParameters::estimator; empty for a reference
   double first_value = 0.0, first_std = 0.0;
   double second_value = 0.0, second_std = 0.0;  ///< a reference's std is 0
   double z = 0.0;

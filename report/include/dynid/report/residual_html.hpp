@@ -37,4 +37,7 @@ struct HtmlReportInput {
 
 std::string residual_html(const HtmlReportInput& input);
 
+/// `text` with the characters HTML gives meaning to (< > & ") escaped.
+std::string html_escape(const std::string& text);
+
 }  // namespace dynid::report

@@ -92,9 +92,12 @@ residual::SimexFit simex_of(const model::Model& model, const std::vector<std::st
 /// The verdict of each of `models` (announced models, with their declared effects) on the run so
 /// far: what a server started with --live-residual publishes beside the estimates. A model that
 /// can be neither diagnosed nor fitted by IV yet (no row, no valid segment long enough to filter,
-/// a noise floor that cannot be measured on so little) is left out, not an error.
+/// a noise floor that cannot be measured on so little) is left out, not an error. `diagnose`
+/// false: the IV and SIMEX fits only, what the publication rule needs (a closed run's tables
+/// without --live-residual: run_service.hpp).
 std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& announcement,
                                                  const std::vector<ingest::Chunk>& chunks,
-                                                 const std::vector<std::string>& models);
+                                                 const std::vector<std::string>& models,
+                                                 bool diagnose = true);
 
 }  // namespace dynid::server

@@ -257,7 +257,9 @@ class RunService {
   void publish(const store::RunKey& key, RunState& run);
   /// With the live verdict on, a run that has grown since its verdict is due a new one
   /// (residual_requests.hpp: live_verdicts()), started once the interval has passed or the run
-  /// is finished and no other diagnosis of this worker is in flight.
+  /// is finished and no other diagnosis of this worker is in flight. With it off, a finished run
+  /// is due the publication's IV and SIMEX fits alone, once: the tables publish what the
+  /// publication rule chooses (residual/publication.hpp) whether or not the live verdict runs.
   void refresh_residual(const store::RunKey& key, const RunState& run);
   void start_residual_job();
   /// A finished diagnosis into its run, which is then published again.

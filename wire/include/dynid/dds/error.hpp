@@ -15,6 +15,10 @@ class DdsError : public std::runtime_error {
   DdsError(const std::string& call, dds_return_t code);
   dds_return_t code() const { return code_; }
 
+ protected:
+  /// A failure `what` explains in full (a subclass's own message), with Cyclone's code.
+  DdsError(dds_return_t code, const std::string& what) : std::runtime_error(what), code_(code) {}
+
  private:
   dds_return_t code_;
 };

@@ -13,6 +13,15 @@
 //   config). The domain is deleted with its last Participant.
 // - Two participants of one process on one domain talk through Cyclone's local delivery, with
 //   the same QoS and partition matching as across processes.
+// - Every process on a host and domain takes one participant index (its unicast ports), with
+//   Discovery/ParticipantIndex "auto" the first free one up to Discovery/MaxAutoParticipantIndex
+//   (deploy/cyclonedds/loopback.xml allows 60). When none is free the domain cannot be created:
+//   NoParticipantIndex says so and what to do, instead of Cyclone's bare "Error". With
+//   ParticipantOptions::index_attempts > 1 the creation is tried again that many times in all,
+//   after randomized waits (about 0.1, 0.2, 0.4, ... s, at most 2 s each; 8 attempts wait at
+//   most 7.1 s): the other programs may end meanwhile (a storm of short CLI requests).
+// - While a domain is created, Cyclone's log goes through this class (to tell that failure from
+//   the others) and is written to stderr unchanged, except the lines of a retried failure.
 #include <dds/dds.h>
 
 #include <filesystem>
@@ -20,12 +29,21 @@
 #include <string>
 
 #include "dynid/dds/entity.hpp"
+#include "dynid/dds/error.hpp"
 
 namespace dynid::dds {
 
 struct ParticipantOptions {
   dds_domainid_t domain_id = 0;
   std::string config;  ///< required, see above
+  int index_attempts = 1;  ///< tries when no participant index is free (see above), >= 1
+};
+
+/// The domain could not be created because every participant index its configuration allows is
+/// held by another process on this host (see the contract above).
+class NoParticipantIndex : public DdsError {
+ public:
+  NoParticipantIndex(dds_domainid_t domain, const std::string& config, int attempts);
 };
 
 /// "file://<absolute path>" for a configuration file. Throws DdsError if it does not exist,

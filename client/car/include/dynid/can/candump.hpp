@@ -13,11 +13,11 @@
 // counts it, and by default continues with the next line; with OnError::Stop it stops at the
 // first bad line (next() returns false and stopped() is true). Only the first
 // kMaxKeptErrors errors are kept in errors(); error_count() counts all of them. A line of
-// kMaxLineBytes or more is bad, and counts as one error per kMaxLineBytes of it: it is read in
-// pieces of that size, so a file without newlines (a sparse file, a device's zeros) is read in
-// bounded memory. stop_after_errors(n) stops the reader (as OnError::Stop does) at its n-th
-// error, so that a look at the start of a file (n lines, say) reads at most about
-// n x kMaxLineBytes bytes of it, whatever the file holds. Opening a path that is not a regular file
+// more than kMaxLineBytes is one bad line whatever its length, skipped to its end in pieces, so a
+// file without newlines (a sparse file, a device's zeros) is read in bounded memory.
+// stop_after_errors(n) stops the reader (as OnError::Stop does) at its n-th error, and
+// stop_after_bytes(n) once it has read about n bytes: a look at the start of a file is bounded
+// by both, whatever the file holds. Opening a path that is not a regular file
 // (FIFO, directory, device) throws InputError naming it (input/input_file.hpp).
 #include <cstddef>
 #include <dynid/can/frame.hpp>

@@ -28,13 +28,17 @@
 //   CM_, VAL_, BA_, SIG_VALTYPE_ and SG_MUL_VAL_ naming it apply to every copy, as in cantools.
 // - Two messages with one name: both load and decode by id; a warning names both lines, and
 //   find_message(name) finds neither (find_messages lists them).
+// - A multiplexed signal no frame can carry (Signal::never_present: a multiplexer value beyond
+//   what its switch's bits can hold, a float switch, a switch that is itself never present)
+//   leaves its message usable (its other signals decode), with a warning naming its line.
 // - Warnings (Database::warnings, "<name>:<line>: ...") also list references to objects the
 //   file does not define (CM_/BA_/VAL_ for an unknown message or signal), unknown words at the
 //   start of a line outside a message (skipped to the next section keyword), ids interpreted,
 //   a missing ';' before the next section, and a file without any message.
 // - A vehicle profile (car/vehicle_profile.hpp) that selects an unusable message, a message
-//   name that several messages have, or an ambiguous signal name is refused with the reason and
-//   the DBC lines; a profile that does not select them is unaffected.
+//   name that several messages have, an ambiguous signal name or a signal that is never present
+//   is refused with the reason and the DBC lines; a profile that does not select them is
+//   unaffected.
 // - parse_dbc_file reads only a regular file of at most input::kMaxTextFileBytes (a FIFO, a
 //   directory or a device is refused: input/input_file.hpp).
 // - The returned Database is immutable in use: decoders keep pointers into it.
@@ -106,6 +110,10 @@ struct Signal {
   // Filled by the parser: index of the switch signal in the message, or -1.
   int multiplexer_index = -1;
   std::size_t line = 0;  // of its SG_ in the file
+  // Filled by the parser: empty when some frame can carry the signal; else why none can,
+  // "<name>:<line>: ...": its multiplexer values are beyond what its switch's bits can hold
+  // (m300 on an 8-bit switch), its switch is a float signal, or its switch is never present.
+  std::string never_present;
 
   bool is_multiplexed() const { return mux_value.has_value(); }
   bool mux_accepts(std::uint64_t switch_raw) const;

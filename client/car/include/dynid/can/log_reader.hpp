@@ -8,7 +8,9 @@
 // Contract (every reader): next() never throws for bad data. A bad line or object is counted
 // (error_count()), the first kMaxKeptErrors are kept with where they are (a line number for the
 // text formats, the byte offset of the object for BLF: describe() says which), and reading
-// continues, or stops with OnError::Stop or at the n-th error (stop_after_errors). Only a file
+// continues, or stops with OnError::Stop, at the n-th error (stop_after_errors) or once n bytes
+// of the file are read (stop_after_bytes: what bounds a look at a file whatever it holds, e.g.
+// one endless line). Only a file
 // that cannot be opened, or is not a regular file (input/input_file.hpp), throws InputError
 // naming it. Frames come out in file order with their timestamps in seconds on the log's clock;
 // a format that stores the measurement start (ASC, BLF) gives start + offset (see its header).
@@ -47,6 +49,8 @@ class LogReader {
   virtual bool next(Frame& frame) = 0;
   /// Stop at the n-th error (counted from the start), whatever on_error says.
   void stop_after_errors(std::size_t n) { max_errors_ = n; }
+  /// Stop once about n bytes of the input are read (a line or object in progress is cut there).
+  void stop_after_bytes(std::uint64_t n) { max_bytes_ = n; }
   const std::vector<LogError>& errors() const { return errors_; }
   std::size_t error_count() const { return error_count_; }
   std::size_t frame_count() const { return frame_count_; }
@@ -61,6 +65,8 @@ class LogReader {
   LogReader(std::string source, OnError on_error) : source_(std::move(source)), on_error_(on_error) {}
   /// Counts an error at `where`, keeps the first kMaxKeptErrors, stops as the contract says.
   void record_error(std::size_t where, std::string reason);
+  /// Bytes left before stop_after_bytes' bound; at 0 the reader is stopped.
+  std::uint64_t byte_budget();
   /// Opens a regular file (input/input_file.hpp), else InputError "<path>: ..." naming `what`.
   static std::unique_ptr<std::ifstream> open_file(const std::filesystem::path& path, std::string_view what);
 
@@ -73,12 +79,13 @@ class LogReader {
   std::vector<LogError> errors_;
   std::size_t error_count_ = 0;
   std::size_t max_errors_ = static_cast<std::size_t>(-1);
+  std::uint64_t max_bytes_ = static_cast<std::uint64_t>(-1);
 };
 
-/// A log of text lines (candump, ASC). Lines are read in pieces of at most max_line_bytes, so
-/// neither memory nor the time one call takes grows with a line's length: a line of
-/// max_line_bytes or more is bad, and counts as one error per max_line_bytes of it. Blank lines
-/// are skipped.
+/// A log of text lines (candump, ASC). A line of more than max_line_bytes is no frame of any
+/// format: it is one bad line ("line of <n> bytes ..."), whatever its length, and is skipped to
+/// its end in pieces, so memory does not grow with it (a look at a file bounded by
+/// stop_after_bytes stops inside an endless line). Blank lines are skipped.
 class LineLogReader : public LogReader {
  public:
   bool next(Frame& frame) final;
@@ -94,7 +101,8 @@ class LineLogReader : public LogReader {
   virtual std::string parse_line(std::string_view line, Frame& frame, bool& is_frame) = 0;
 
  private:
-  bool read_line(bool& too_long, bool& continued);
+  bool read_line(bool& too_long);
+  std::string skip_long_line();
 
   std::unique_ptr<std::ifstream> file_;
   std::istream* in_;
@@ -102,7 +110,6 @@ class LineLogReader : public LogReader {
   std::string buffer_;
   std::size_t line_ = 0;
   std::uint64_t bytes_ = 0;
-  bool in_long_line_ = false;  // the last piece read filled the buffer before a newline
 };
 
 /// The format of the file at `path` by its first bytes (see above); throws InputError when it

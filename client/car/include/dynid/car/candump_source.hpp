@@ -21,8 +21,7 @@ namespace dynid::car {
 
 class CandumpSource final : public FrameSource {
  public:
-  /// max_bad_lines: the source ends at that many bad lines (CandumpReader::stop_after_errors):
-  /// a look at the start of a file that is no log stays bounded.
+  /// max_bad_lines: the source ends at that many bad lines (CandumpReader::stop_after_errors).
   explicit CandumpSource(const std::filesystem::path& path,
                          std::size_t max_bad_lines = static_cast<std::size_t>(-1));
 

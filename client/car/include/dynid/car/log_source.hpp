@@ -22,8 +22,11 @@ namespace dynid::car {
 
 class LogSource final : public FrameSource {
  public:
-  /// max_bad: the source ends at that many bad lines or objects (a bounded look at a file).
-  explicit LogSource(const std::filesystem::path& path, std::size_t max_bad = static_cast<std::size_t>(-1));
+  /// max_bad, max_bytes: the source ends at that many bad lines or objects, or once it has read
+  /// about that many bytes (a bounded look at a file, whatever it holds).
+  explicit LogSource(const std::filesystem::path& path,
+                     std::size_t max_bad = static_cast<std::size_t>(-1),
+                     std::uint64_t max_bytes = static_cast<std::uint64_t>(-1));
 
   NextStatus next(can::Frame& frame, std::chrono::milliseconds timeout) override;
   std::uint64_t bad_input() const override { return reader_->error_count(); }

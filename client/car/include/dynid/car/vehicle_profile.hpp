@@ -16,7 +16,9 @@
 // reference against it. Every error throws InputError "<profile file>:<line>:<column>: <key>:
 // <reason>" (line and column when the key exists), for: a vehicle id that breaks the id rule
 // (input/ids.hpp), TOML syntax, missing keys and wrong types, unknown or
-// duplicate channel, unknown DBC message or signal, a DBC that cannot be read, a missing unit
+// duplicate channel, unknown DBC message or signal, a DBC signal no frame can carry (a
+// multiplexer value its switch cannot hold: can::Signal::never_present), a DBC that cannot be
+// read, a missing unit
 // (empty DBC unit for a dimensioned channel and no dbc_unit/factor), an unconvertible unit,
 // a non-finite or non-positive number where one is required, an unknown model or a model whose
 // constants it rejects, an unknown constant name in scale/divide_by; in [[sources]]: a name that
@@ -146,6 +148,14 @@ struct VehicleProfile {
   /// The announcement of a run of this vehicle (channels with units, rate, models).
   ingest::RunAnnouncement announcement(const std::string& run) const;
 };
+
+/// The models of a run's profile (the bus channels and those of the sources given for the run:
+/// auxiliary.hpp) that the server could not run for want of a channel, by the server's own rule
+/// (ingest/model_channels.hpp: derived d_<x> count when <x> is a channel; constants never stand
+/// in for one): one line each, "models[i] '<name>' needs ..., which this run does not have",
+/// with the optional channels it also lacks and the declared sources not given that have them.
+/// Empty when every model can run. dynid-car refuses such a run before anything is sent.
+std::vector<std::string> models_lacking_channels(const VehicleProfile& profile);
 
 VehicleProfile load_vehicle_profile(const std::filesystem::path& path);
 /// Parses profile text; `source` names it in messages and relative paths resolve against its
