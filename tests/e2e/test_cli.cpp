@@ -1,6 +1,7 @@
 // (d) The dynid executable against a running server: `dynid estimates --vehicle V` prints the
 // table (parameter, unit, value, std, relative std %, status; rows, sigma, cond, residual RMS),
 // the other commands answer, and without a server it says so within its timeout.
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
@@ -137,6 +138,57 @@ TEST(E2eCli, SaysSoWhenNoServerAnswers) {
   const auto no_config = run_command({DYNID_CLI_EXE, "vehicles"}, 10s);
   EXPECT_EQ(no_config.exit_code, 2);
   EXPECT_NE(no_config.err.find("--cyclone-config"), std::string::npos) << no_config.err;
+}
+
+TEST(E2eCli, AnEmptyServerSaysItIsEmpty) {
+  TempDir dir;
+  InProcessServer server(server_options(dir.file("store.db")));
+  const auto text = dynid({"vehicles"});
+  EXPECT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_EQ(text.out, "no vehicles yet: a car's first run announces its vehicle\n") << text.err;
+  const auto json = dynid({"--json", "vehicles"});
+  EXPECT_EQ(json.out, "[]\n") << json.err;
+}
+
+// The catalogue is answered without a server or a DDS configuration, from the models' own code:
+// every model, what it reads (a constant its constructor asks for), its effects; an unknown name
+// is answered with the known ones; docs/PROFILES.md's table is the one the program prints.
+TEST(E2eCli, ModelsAndEffectsAreAnsweredWithoutAServer) {
+  const auto models = run_command({DYNID_CLI_EXE, "models"}, 10s);
+  ASSERT_EQ(models.exit_code, 0) << models.err;
+  for (const char* name : {"longitudinal_engine", "lateral_bicycle", "clutch_slip", "tyre_rr"})
+    EXPECT_NE(models.out.find(std::string(name) + "\n  channels:"), std::string::npos)
+        << name << " in " << models.out;
+  const auto engine = run_command({DYNID_CLI_EXE, "models", "--model", "longitudinal_engine"}, 10s);
+  ASSERT_EQ(engine.exit_code, 0) << engine.err;
+  EXPECT_TRUE(std::regex_search(engine.out, std::regex("\n  channels: +[^\n]*engine_torque")))
+      << engine.out;
+  EXPECT_TRUE(std::regex_search(
+      engine.out, std::regex("\n  constants: +wheel_radius, air_density, driveline_efficiency\n")))
+      << engine.out;
+  EXPECT_TRUE(std::regex_search(engine.out,
+                                std::regex("optional constants: [^\n]*min_speed \\(default 1\\)")))
+      << engine.out;
+  EXPECT_TRUE(std::regex_search(engine.out, std::regex("identifies: +mass, "))) << engine.out;
+  const auto effects =
+      run_command({DYNID_CLI_EXE, "effects", "--model", "longitudinal_wheel"}, 10s);
+  ASSERT_EQ(effects.exit_code, 0) << effects.err;
+  EXPECT_NE(effects.out.find("\n  road_grade: grade load"), std::string::npos) << effects.out;
+  EXPECT_NE(effects.out.find("adds channels: road_grade\n"), std::string::npos) << effects.out;
+  EXPECT_NE(effects.out.find("dict:<op>:<channel>"), std::string::npos) << effects.out;
+  const auto unknown = run_command({DYNID_CLI_EXE, "effects", "--model", "longitudnal_wheel"}, 10s);
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("unknown model 'longitudnal_wheel' (known: body "), std::string::npos)
+      << unknown.err;
+
+  const auto table = run_command({DYNID_CLI_EXE, "models", "--markdown"}, 10s);
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  std::ifstream doc(std::string(DYNID_SOURCE_DIR) + "/docs/PROFILES.md");
+  std::stringstream text;
+  text << doc.rdbuf();
+  EXPECT_NE(text.str().find(table.out), std::string::npos)
+      << "docs/PROFILES.md holds the table `dynid models --markdown` prints:\n"
+      << table.out;
 }
 
 }  // namespace

@@ -146,7 +146,7 @@ TEST(E2eResidualCli, DiagnosesAndTracesInTextAndJson) {
   args.insert(args.end(), {"--rounds", "99"});
   const auto rounds = dynid(args);
   EXPECT_EQ(rounds.exit_code, 2);
-  EXPECT_NE(rounds.err.find("0 to 10"), std::string::npos) << rounds.err;
+  EXPECT_NE(rounds.err.find("outside [0, 10]"), std::string::npos) << rounds.err;
 
   // Across models a reference names the quantity: which accelerometer's scale, not a name two
   // sensors share.

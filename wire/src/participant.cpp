@@ -110,14 +110,17 @@ std::chrono::milliseconds retry_wait(int attempt, std::mt19937& random) {
 
 std::shared_ptr<Participant::Domain> acquire_domain(const ParticipantOptions& options) {
   std::mt19937 random(std::random_device{}());
+  const auto deadline = std::chrono::steady_clock::now() + options.index_wait;
   for (int attempt = 1;; ++attempt) {
     try {
       return acquire_domain(options.domain_id, options.config);
     } catch (const NoParticipantIndex&) {
-      if (attempt >= options.index_attempts)
+      const auto left = deadline - std::chrono::steady_clock::now();
+      if (left <= std::chrono::steady_clock::duration::zero())
         throw NoParticipantIndex(options.domain_id, options.config, attempt);
+      std::this_thread::sleep_for(
+          std::min<std::chrono::steady_clock::duration>(retry_wait(attempt, random), left));
     }
-    std::this_thread::sleep_for(retry_wait(attempt, random));
   }
 }
 

@@ -11,7 +11,7 @@
 // id or run name that breaks the id rule of dynid/input/ids.hpp), 3 not found, 4 the server failed
 // (or the servers disagree on the shard count), 5 no server answered in time, 6 some shards did not
 // answer (the output holds the others'), 7 no DDS participant index was free on this host (other
-// DDS programs hold them all: retried for about 7 s first).
+// DDS programs hold them all: retried for 20 s first).
 #include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -23,6 +23,7 @@
 
 #include <dynid/options/option_checks.hpp>
 
+#include "dynid/cli/catalogue_view.hpp"
 #include "dynid/cli/request_client.hpp"
 #include "dynid/cli/shard_replies.hpp"
 #include "dynid/cli/watch_view.hpp"
@@ -50,13 +51,14 @@ struct Common {
 };
 
 // A request is cheap to repeat, and a storm of them (a script starting many at once) may hold
-// every participant index of the host for a moment: the creation is retried, for up to about
-// 7 s (participant.hpp), before the CLI gives up with exit 7.
-constexpr int kParticipantAttempts = 8;
+// every participant index of the host for a moment: the creation is retried for up to 20 s
+// (participant.hpp), before the CLI gives up with exit 7. Long enough for a few rounds of
+// ordinary requests ahead of it to end, short against a request's own timeout.
+constexpr std::chrono::seconds kParticipantWait{20};
 
 dynid::dds::ParticipantOptions participant_options(const Common& c) {
   dynid::dds::ParticipantOptions o{c.domain, dynid::dds::config_uri(c.config)};
-  o.index_attempts = kParticipantAttempts;
+  o.index_wait = kParticipantWait;
   return o;
 }
 
@@ -92,8 +94,11 @@ int request_all(const Common& c, dynid::cli::RequestClient& client, const std::s
   if (const auto failure = replies.failure()) return print(kind, *failure);
   if (kind == "status")
     std::cout << (c.json ? dynid::cli::merged_status(replies) + "\n" : dynid::cli::status_text(replies));
+  else if (const auto vehicles = dynid::cli::merged_vehicles(replies); vehicles.empty() && !c.json)
+    std::cout << (replies.complete() ? "no vehicles yet: a car's first run announces its vehicle\n"
+                                     : "no vehicles on the servers that answered\n");
   else
-    std::cout << dynid::cli::render_vehicles(dynid::cli::merged_vehicles(replies), c.json) << (c.json ? "\n" : "");
+    std::cout << dynid::cli::render_vehicles(vehicles, c.json) << (c.json ? "\n" : "");
   const std::string note =
       dynid::cli::missing_note(replies, timeout_of(c).count(), kind == "status" ? "counters" : "vehicles");
   if (note.empty()) return 0;
@@ -195,6 +200,30 @@ void check_ids(std::initializer_list<std::pair<const char*, std::string>> single
     if (!item.empty()) check("--vehicles", item);
 }
 
+// The options most subcommands share, with one help text each.
+CLI::Option* vehicle_option(CLI::App* command, std::string& vehicle) {
+  return command
+      ->add_option("--vehicle", vehicle,
+                   "the vehicle id (its profile's [vehicle] id; `dynid vehicles` lists them)")
+      ->required();
+}
+
+CLI::Option* run_option(CLI::App* command, std::string& run, bool required) {
+  auto* option = command->add_option(
+      "--run", run,
+      required ? "the run name (`dynid runs --vehicle V` lists them)"
+               : "the run name (`dynid runs --vehicle V` lists them; default: the latest run)");
+  return required ? option->required() : option;
+}
+
+CLI::Option* model_option(CLI::App* command, std::string& model, bool required) {
+  auto* option = command->add_option(
+      "--model", model,
+      required ? "a model of the run (`dynid models` lists the models and what each needs)"
+               : "only this model of the run (default: every model; `dynid models` lists them)");
+  return required ? option->required() : option;
+}
+
 std::vector<RequestArgument> args(std::initializer_list<std::pair<const char*, std::string>> list) {
   std::vector<RequestArgument> out;
   for (const auto& [name, value] : list)
@@ -214,7 +243,7 @@ int main(int argc, char** argv) {
       "--cyclone-config", c.config,
       "Cyclone DDS configuration: file, file:// URI or XML (or $DYNID_CYCLONE_CONFIG). When "
       "other DDS programs hold every participant index it allows, joining is retried for up "
-      "to about 7 s, then exit 7");
+      "to 20 s, then exit 7");
   app.add_option("--domain", c.domain, "DDS domain id")->check(dynid::input::within(0, 230));
   auto* timeout = app.add_option("--timeout", c.timeout_s,
                                  "seconds to wait for the server (default 10; 120 for residual, add-effect, trace, consistency, iv)")
@@ -226,46 +255,46 @@ int main(int argc, char** argv) {
   double seconds = 10.0;
   auto* vehicles_cmd = app.add_subcommand("vehicles", "list the vehicles");
   auto* runs_cmd = app.add_subcommand("runs", "list a vehicle's runs: chunks stored, in order, folded; complete or not");
-  runs_cmd->add_option("--vehicle", vehicle)->required();
+  vehicle_option(runs_cmd, vehicle);
   auto* estimates_cmd = app.add_subcommand("estimates", "estimate tables (latest run by default)");
-  estimates_cmd->add_option("--vehicle", vehicle)->required();
-  estimates_cmd->add_option("--run", run);
-  estimates_cmd->add_option("--model", model);
+  vehicle_option(estimates_cmd, vehicle);
+  run_option(estimates_cmd, run, false);
+  model_option(estimates_cmd, model, false);
   auto* excitation_cmd = app.add_subcommand(
       "excitation", "what a run (latest by default) identifies, and the manoeuvres that would identify the rest");
-  excitation_cmd->add_option("--vehicle", vehicle)->required();
-  excitation_cmd->add_option("--run", run);
+  vehicle_option(excitation_cmd, vehicle);
+  run_option(excitation_cmd, run, false);
   auto* watch_cmd = app.add_subcommand(
       "watch", "print estimates as they are published (--model: one model, compact, updated in place)");
-  watch_cmd->add_option("--vehicle", vehicle)->required();
+  vehicle_option(watch_cmd, vehicle);
   watch_cmd->add_option("--model", model,
                         "follow this model: one line per parameter (value, std, status, how it moved); "
                         "JSON lines with --json");
   watch_cmd->add_option("--seconds", seconds, "how long to watch")
       ->check(dynid::input::within(kMinSeconds, kMaxSeconds));
   auto* pooled_cmd = app.add_subcommand("pooled", "estimate over several runs of a vehicle");
-  pooled_cmd->add_option("--vehicle", vehicle)->required();
+  vehicle_option(pooled_cmd, vehicle);
   pooled_cmd->add_option("--run", runs, "runs to pool (repeat)")->required();
-  pooled_cmd->add_option("--model", model);
+  model_option(pooled_cmd, model, false);
   auto* reprocess_cmd = app.add_subcommand("reprocess", "replay a run with another model/effects");
-  reprocess_cmd->add_option("--vehicle", vehicle)->required();
-  reprocess_cmd->add_option("--run", run)->required();
-  reprocess_cmd->add_option("--model", model)->required();
+  vehicle_option(reprocess_cmd, vehicle);
+  run_option(reprocess_cmd, run, true);
+  model_option(reprocess_cmd, model, true);
   reprocess_cmd->add_option("--effects", effects, "comma-separated candidate effects");
   std::string candidates, effect, html;
   std::vector<std::string> references;
   auto* residual_cmd = app.add_subcommand("residual", "which effect does a run's model lack? (docs/RESIDUAL.md)");
-  residual_cmd->add_option("--vehicle", vehicle)->required();
-  residual_cmd->add_option("--run", run)->required();
-  residual_cmd->add_option("--model", model)->required();
+  vehicle_option(residual_cmd, vehicle);
+  run_option(residual_cmd, run, true);
+  model_option(residual_cmd, model, true);
   residual_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's)");
   residual_cmd->add_option("--candidates", candidates, "test only these candidates (comma-separated)");
   residual_cmd->add_option("--html", html, "write the HTML report with plots to this file")
       ->check(dynid::input::output_file("HTML report"));
   auto* add_effect_cmd = app.add_subcommand("add-effect", "a run's model with one more effect: before and after");
-  add_effect_cmd->add_option("--vehicle", vehicle)->required();
-  add_effect_cmd->add_option("--run", run)->required();
-  add_effect_cmd->add_option("--model", model)->required();
+  vehicle_option(add_effect_cmd, vehicle);
+  run_option(add_effect_cmd, run, true);
+  model_option(add_effect_cmd, model, true);
   add_effect_cmd->add_option("--effect", effect, "the effect to add, e.g. road_grade")->required();
   add_effect_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's)");
   add_effect_cmd->add_option("--html", html, "write the HTML report with plots to this file")
@@ -275,29 +304,30 @@ int main(int argc, char** argv) {
   const char* series_help =
       "with --json: the added effect's fitted contribution row by row (effect_series)";
   add_effect_cmd->add_flag("--series", series, series_help);
-  std::string rounds;
+  int rounds = -1;  // unset: the server's default
   auto* trace_cmd = app.add_subcommand(
       "trace", "the residual loop: diagnose, add the effect that explains the residual, again (docs/RESIDUAL.md)");
-  trace_cmd->add_option("--vehicle", vehicle)->required();
-  trace_cmd->add_option("--run", run)->required();
-  trace_cmd->add_option("--model", model)->required();
+  vehicle_option(trace_cmd, vehicle);
+  run_option(trace_cmd, run, true);
+  model_option(trace_cmd, model, true);
   trace_cmd->add_option("--effects", effects, "the model's declared effects (default: the run's; none: no effect)");
   trace_cmd->add_option("--reference", references, "a known value, name=value (repeat), e.g. mass=1457.5");
-  trace_cmd->add_option("--rounds", rounds, "effects the loop may add (0 to 10, default 4)");
+  trace_cmd->add_option("--rounds", rounds, "effects the loop may add (0 to 10, default 4)")
+      ->check(dynid::input::within(0, 10));
   trace_cmd->add_flag("--series", series, series_help);
   trace_cmd->add_option("--html", html, "write the HTML report with plots to this file")
       ->check(dynid::input::output_file("HTML report"));
   auto* consistency_cmd = app.add_subcommand(
       "consistency", "do a run's models agree with each other and with known values? (docs/RESIDUAL.md)");
-  consistency_cmd->add_option("--vehicle", vehicle)->required();
-  consistency_cmd->add_option("--run", run)->required();
+  vehicle_option(consistency_cmd, vehicle);
+  run_option(consistency_cmd, run, true);
   consistency_cmd->add_option("--reference", references, "a known value, name=value (repeat), e.g. mass=1457.5");
   // Another estimator of one model on one stored run, beside least squares.
   const auto estimator_command = [&](const char* name, const char* description) {
     auto* command = app.add_subcommand(name, description);
-    command->add_option("--vehicle", vehicle)->required();
-    command->add_option("--run", run)->required();
-    command->add_option("--model", model)->required();
+    vehicle_option(command, vehicle);
+    run_option(command, run, true);
+    model_option(command, model, true);
     command->add_option("--effects", effects, "the model's declared effects (default: the run's; none: no effect)");
     return command;
   };
@@ -308,12 +338,12 @@ int main(int argc, char** argv) {
       "simex", "least squares corrected for the measured sensor noise (SIMEX), beside least squares, and "
                "which one the server publishes (docs/ACCURACY.md)");
   auto* base_cmd = app.add_subcommand("base", "base-parameter report of a run's model");
-  base_cmd->add_option("--vehicle", vehicle)->required();
-  base_cmd->add_option("--run", run)->required();
-  base_cmd->add_option("--model", model)->required();
+  vehicle_option(base_cmd, vehicle);
+  run_option(base_cmd, run, true);
+  model_option(base_cmd, model, true);
   auto* close_cmd = app.add_subcommand("close", "close a run (final estimates)");
-  close_cmd->add_option("--vehicle", vehicle)->required();
-  close_cmd->add_option("--run", run)->required();
+  vehicle_option(close_cmd, vehicle);
+  run_option(close_cmd, run, true);
   auto* status_cmd = app.add_subcommand(
       "status", "the server's counters, one per line with what it counts; with servers sharing one "
                 "PostgreSQL store, which server holds which vehicles (--json: raw)");
@@ -326,6 +356,19 @@ int main(int argc, char** argv) {
   fleet_cmd->add_option("--vehicles", fleet_vehicles,
                      "comma-separated vehicles (closed runs, else the latest), all of one shard")
       ->required();
+  bool markdown = false;
+  auto* models_cmd = app.add_subcommand(
+      "models",
+      "the models, with the channels and constants each needs and what it identifies "
+      "(answered here, no server)");
+  models_cmd->add_option("--model", model, "only this model");
+  models_cmd->add_flag("--markdown", markdown,
+                       "one table of every model, as docs/PROFILES.md has it");
+  auto* effects_cmd = app.add_subcommand(
+      "effects",
+      "a model's candidate effects: the physics, the channels each adds, its parameters "
+      "(answered here, no server)");
+  effects_cmd->add_option("--model", model, "the model (`dynid models` lists them)")->required();
   try {
     app.parse(argc, argv);
     check_ids({{"--vehicle", vehicle}, {"--run", run}}, runs, fleet_vehicles);
@@ -334,6 +377,19 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     return 2;
+  } catch (const dynid::InputError& e) {
+    std::cerr << "dynid: " << e.what() << "\n";
+    return 2;
+  }
+  try {
+    if (*models_cmd) {
+      std::cout << (markdown ? dynid::cli::models_markdown() : dynid::cli::models_text(model));
+      return 0;
+    }
+    if (*effects_cmd) {
+      std::cout << dynid::cli::effects_text(model);
+      return 0;
+    }
   } catch (const dynid::InputError& e) {
     std::cerr << "dynid: " << e.what() << "\n";
     return 2;
@@ -368,7 +424,7 @@ int main(int argc, char** argv) {
                      {"effects", effects},
                      {"candidates", candidates},
                      {"effect", effect},
-                     {"rounds", rounds},
+                     {"rounds", rounds < 0 ? "" : std::to_string(rounds)},
                      {"format", html.empty() ? "" : "html"},
                      {"series", series ? "yes" : ""}});
       for (const auto& r : references) a.push_back({"reference", r});

@@ -17,13 +17,15 @@
 //   Discovery/ParticipantIndex "auto" the first free one up to Discovery/MaxAutoParticipantIndex
 //   (deploy/cyclonedds/loopback.xml allows 60). When none is free the domain cannot be created:
 //   NoParticipantIndex says so and what to do, instead of Cyclone's bare "Error". With
-//   ParticipantOptions::index_attempts > 1 the creation is tried again that many times in all,
-//   after randomized waits (about 0.1, 0.2, 0.4, ... s, at most 2 s each; 8 attempts wait at
-//   most 7.1 s): the other programs may end meanwhile (a storm of short CLI requests).
+//   ParticipantOptions::index_wait > 0 the creation is tried again after randomized waits
+//   (about 0.1, 0.2, 0.4, ... s, at most 2 s each) until that much time has passed: the other
+//   programs may end meanwhile (a storm of short CLI requests). A budget of time, not of
+//   attempts, because how long the others hold their indices is what decides.
 // - While a domain is created, Cyclone's log goes through this class (to tell that failure from
 //   the others) and is written to stderr unchanged, except the lines of a retried failure.
 #include <dds/dds.h>
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -36,7 +38,8 @@ namespace dynid::dds {
 struct ParticipantOptions {
   dds_domainid_t domain_id = 0;
   std::string config;  ///< required, see above
-  int index_attempts = 1;  ///< tries when no participant index is free (see above), >= 1
+  /// How long to keep trying when no participant index is free (see above); 0: one try.
+  std::chrono::milliseconds index_wait{0};
 };
 
 /// The domain could not be created because every participant index its configuration allows is
