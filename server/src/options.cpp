@@ -71,7 +71,8 @@ std::optional<ServerOptions> parse_options(int argc, const char* const* argv) {
                "estimates over Cyclone DDS"};
   app.add_option("--store", o.store_path, "SQLite store file, or a postgresql:// URI")->required()->check(new_or_regular_file());
   app.add_option("--cyclone-config", o.cyclone_config,
-                 "Cyclone DDS configuration (file, file:// URI or XML)")
+                 "Cyclone DDS configuration (file, file:// URI or XML; or $DYNID_CYCLONE_CONFIG)")
+      ->envname("DYNID_CYCLONE_CONFIG")
       ->required();
   app.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 230));
   app.add_option("--threads", o.threads, "folding workers (0: one per core)")

@@ -221,6 +221,32 @@ TEST(CarProfile, ConstantsAndModels) {
   expect_error(replace(kGood, "b = 1.5\n", ""), ":15:", "models[0].name", "'b'");
 }
 
+// A constant nobody reads loads, but is said: a misspelling, or a channel given as a constant
+// (a manual car's gear ratio), which would otherwise be ignored without a word.
+TEST(CarProfile, AConstantNoModelReadsIsAWarningNamingItsLine) {
+  EXPECT_TRUE(parse_vehicle_profile(kGood, profile_path("broken.toml")).warnings.empty())
+      << "steering_ratio is a gain term's, a and b the bicycle's";
+  const std::string text =
+      replace(replace(kGood, "b = 1.5\n", "b = 1.5\ngear_ratio = 3.5\nmas = 1500.0\n"),
+              "name = \"lateral_bicycle\"\n",
+              "name = \"lateral_bicycle\"\nconstants = { min_sped = 2.0, min_speed = 2.0 }\n");
+  const VehicleProfile p = parse_vehicle_profile(text, profile_path("broken.toml"));
+  ASSERT_EQ(p.warnings.size(), 3U) << ::testing::PrintToString(p.warnings);
+  const std::string file = profile_path("broken.toml").string();
+  EXPECT_EQ(p.warnings[0].rfind(file + ":19:", 0), 0U) << p.warnings[0];
+  EXPECT_NE(p.warnings[0].find("models[0].constants.min_sped: read by no constant of model "
+                               "'lateral_bicycle'"),
+            std::string::npos)
+      << p.warnings[0];
+  EXPECT_EQ(p.warnings[1].rfind(file + ":15:", 0), 0U) << p.warnings[1];
+  EXPECT_NE(p.warnings[1].find("constants.gear_ratio: 'gear_ratio' is a channel, not a constant"),
+            std::string::npos)
+      << p.warnings[1];
+  EXPECT_NE(p.warnings[2].find("constants.mas: read by no model of this profile"),
+            std::string::npos)
+      << p.warnings[2];
+}
+
 // Issue 16 item 5: [preprocessing] sets the server's processing per vehicle; absent keys keep
 // today's values (ingest::Preprocessing's defaults), and every run's announcement carries it.
 TEST(CarProfile, PreprocessingPerVehicleWithTodaysDefaults) {

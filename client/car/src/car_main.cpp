@@ -151,11 +151,17 @@ void report_dbc_warnings(const VehicleProfile& profile) {
   if (warnings.size() > kShown) spdlog::warn("  ... and {} more", warnings.size() - kShown);
 }
 
+// What the profile's loader passed over (vehicle_profile.hpp: constants nobody reads).
+void report_profile_warnings(const VehicleProfile& profile) {
+  for (const std::string& warning : profile.warnings) spdlog::warn("{}", warning);
+}
+
 // The profile of this run: the declared one with the auxiliary sources given (auxiliary.hpp),
 // their clocks put on the bus's (an estimate reads the replayed log once), reported.
 RunSources run_profile(const Options& options) {
   const VehicleProfile declared = load_vehicle_profile(options.profile);
   report_dbc_warnings(declared);
+  report_profile_warnings(declared);
   std::map<std::string, std::filesystem::path> given;
   for (const auto& s : options.sources) {
     const std::size_t eq = s.find('=');
@@ -491,9 +497,12 @@ int main(int argc, char** argv) {
   Options o;
   app.add_option("--profile", o.profile, "vehicle profile (TOML)")->required()->check(input::input_file("vehicle profile"));
   app.add_option("--run", o.run, "run id (default: run-<UTC time>)")->check(input::id("run name"));
-  app.add_option("--cyclone-config", o.cyclone_config,
-                 "Cyclone DDS configuration: a file (deploy/cyclonedds/*.xml), or file:// URIs and XML "
-                 "fragments, comma-separated, as in CYCLONEDDS_URI (required unless --chunks-out)");
+  app.add_option(
+         "--cyclone-config", o.cyclone_config,
+         "Cyclone DDS configuration: a file (deploy/cyclonedds/*.xml), or file:// URIs and XML "
+         "fragments, comma-separated, as in CYCLONEDDS_URI; or $DYNID_CYCLONE_CONFIG "
+         "(required unless --chunks-out)")
+      ->envname("DYNID_CYCLONE_CONFIG");
   app.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 230));
   auto* replay_opt = app.add_option("--replay", o.replay, "replay this CAN log (candump -l, Vector ASC or BLF, told by its content)")->check(input::input_file("CAN log"));
   auto* can_opt = app.add_option("--can", o.can, "read this SocketCAN interface live (e.g. can0)");

@@ -11,6 +11,7 @@
 #include <dynid/ingest/model_channels.hpp>
 #include <dynid/input/ids.hpp>
 #include <dynid/input/input_file.hpp>
+#include <dynid/model/model_needs.hpp>
 #include <dynid/model/registry.hpp>
 
 #include "dynid/model/channel_catalogue.hpp"
@@ -33,11 +34,17 @@ class Reader {
 
   [[noreturn]] void fail(const std::string& key, const std::string& reason,
                          const toml::node* node = nullptr) const {
+    throw InputError(message(key, reason, node));
+  }
+
+  /// "<file>:<line>:<column>: <key>: <reason>" (line and column when the node has them).
+  std::string message(const std::string& key, const std::string& reason,
+                      const toml::node* node = nullptr) const {
     std::string where = source_.string();
     if (node != nullptr && node->source().begin.line > 0)
       where += ":" + std::to_string(node->source().begin.line) + ":" +
                std::to_string(node->source().begin.column);
-    throw InputError(where + ": " + input::printable_text(key + ": " + reason));  // the file's text, escaped
+    return where + ": " + input::printable_text(key + ": " + reason);  // the file's text, escaped
   }
 
   const toml::table& table(const toml::table& parent, const std::string& key,
@@ -674,6 +681,61 @@ std::vector<std::string> models_lacking_channels(const VehicleProfile& p) {
   return out;
 }
 
+namespace {
+
+// Every string value of the document: a gain term names its constant by one (gain_term).
+void collect_strings(const toml::node& node, std::set<std::string>& out) {
+  if (const auto* s = node.as_string()) out.insert(s->get());
+  if (const auto* t = node.as_table())
+    for (const auto& [key, value] : *t) collect_strings(value, out);
+  if (const auto* a = node.as_array())
+    for (const auto& value : *a) collect_strings(value, out);
+}
+
+std::set<std::string> constants_read(const std::string& model) {
+  std::set<std::string> out;
+  for (const model::ConstantUse& use : model::model_needs(model).constants) out.insert(use.name);
+  return out;
+}
+
+std::string unread_reason(const std::string& name, const std::string& readers) {
+  if (model::channel_unit(name))
+    return "'" + name + "' is a channel, not a constant: constants never stand in for a channel " +
+           "(map it under [channels])";
+  return "read by " + readers + ": it has no effect (a misspelling? `dynid models` lists what " +
+         "each model reads)";
+}
+
+// A constant nobody reads is a misspelling or a channel given as a constant: said at load, not
+// silently ignored (the profile still loads: it may serve models or tools to come).
+void warn_unread_constants(const Reader& r, const toml::table& root, VehicleProfile& p) {
+  std::set<std::string> named, read;
+  if (const toml::node* channels = root.get("channels")) collect_strings(*channels, named);
+  if (const toml::node* sources = root.get("sources")) collect_strings(*sources, named);
+  const toml::array* models = root.get("models") ? root.get("models")->as_array() : nullptr;
+  for (std::size_t i = 0; i < p.models.size(); ++i) {
+    const std::set<std::string> own = constants_read(p.models[i].model);
+    read.insert(own.begin(), own.end());
+    const toml::table* entry = models != nullptr ? models->get(i)->as_table() : nullptr;
+    const toml::node* table = entry != nullptr ? entry->get("constants") : nullptr;
+    if (table == nullptr || !table->is_table()) continue;
+    for (const auto& [key, value] : *table->as_table())
+      if (const std::string name(key.str()); !own.contains(name))
+        p.warnings.push_back(r.message(
+            "models[" + std::to_string(i) + "].constants." + name,
+            unread_reason(name, "no constant of model '" + p.models[i].model + "'"), &value));
+  }
+  const toml::node* constants = root.get("constants");
+  if (constants == nullptr || !constants->is_table()) return;
+  for (const auto& [key, value] : *constants->as_table())
+    if (const std::string name(key.str()); !read.contains(name) && !named.contains(name))
+      p.warnings.push_back(r.message(
+          "constants." + name,
+          unread_reason(name, "no model of this profile and named by no channel's gain"), &value));
+}
+
+}  // namespace
+
 VehicleProfile parse_vehicle_profile(std::string_view text, const std::filesystem::path& source) {
   const Reader r(source);
   toml::table root;
@@ -696,6 +758,7 @@ VehicleProfile parse_vehicle_profile(std::string_view text, const std::filesyste
   read_channels(r, root, p);
   read_sources(r, root, p);
   read_preprocessing(r, root, p);
+  warn_unread_constants(r, root, p);
   return p;
 }
 

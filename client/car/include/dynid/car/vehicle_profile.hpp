@@ -143,6 +143,10 @@ struct VehicleProfile {
   std::uint64_t spool_max_bytes = 0;
   /// [preprocessing]: carried in every run's announcement to the server (defaults: DYCARO's).
   ingest::Preprocessing preprocessing;
+  /// What loads but is likely a mistake, "<file>:<line>:<column>: <key>: <why>": a constant that
+  /// no model of the profile reads (model/model_needs.hpp) and no channel's gain names, or a
+  /// catalogue channel's name given as a constant (constants never stand in for a channel).
+  std::vector<std::string> warnings;
 
   bool accepts_interface(std::string_view name) const;
   /// The announcement of a run of this vehicle (channels with units, rate, models).
