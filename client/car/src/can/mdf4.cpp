@@ -219,6 +219,10 @@ std::string Mdf4File::text(std::uint64_t link) const {
     if (open != std::string::npos && close != std::string::npos && close > open)
       s = s.substr(open + 4, close - open - 4);
   }
+  // Names are kept: many channels naming one huge text must not multiply it in memory.
+  text_kept_ += s.size();
+  if (text_kept_ > kMaxTextBytes)
+    fail(link, "more than " + std::to_string(kMaxTextBytes) + " bytes of names and texts");
   return s;
 }
 

@@ -133,6 +133,11 @@ void Mdf4BusReader::open_groups() {
       c->esi = field("ESI");
       c->bytes = field("DataBytes");
       if (c->bytes != nullptr && c->bytes->type == Mdf4Channel::Vlsd) {
+        // the record holds a 64-bit offset into the values
+        if (c->bytes->bit_offset != 0 || c->bytes->bit_count != 64 ||
+            c->bytes->byte_offset + 8ULL > g.data_bytes)
+          throw Mdf4Error(source(), c->bytes->offset,
+                          "CAN_DataFrame.DataBytes: a VLSD offset is 64 bits in its records");
         c->vlsd = file_->vlsd_stream(d, *c->bytes, records);
       } else if (c->bytes != nullptr &&
                  (c->bytes->bit_offset != 0 || c->bytes->bit_count % 8 != 0 ||
@@ -169,7 +174,8 @@ bool Mdf4BusReader::decode(Cursor& c, std::size_t k, Frame& f) {
     return ch ? Mdf4File::raw_bits(*ch, rec) : absent;
   };
   f = Frame{};
-  double t = Mdf4File::raw_value(*c.time, rec);
+  double t = c.time->type == Mdf4Channel::VirtualMaster ? static_cast<double>(k)
+                                                        : Mdf4File::raw_value(*c.time, rec);
   if (c.time->conversion) t = c.time->conversion->apply(t);
   if (!std::isfinite(t) || std::fabs(t) > 1e9)
     return bad("time " + std::to_string(t) + " s is not readable");
@@ -210,7 +216,8 @@ bool Mdf4BusReader::decode(Cursor& c, std::size_t k, Frame& f) {
     return bad(std::string(f.fd ? "CAN FD" : "classic CAN") + " frame of " +
                std::to_string(length) + " bytes");
   f.length = static_cast<std::uint8_t>(length);
-  std::memcpy(f.data.data(), payload.data(), length);
+  if (length != 0)
+    std::memcpy(f.data.data(), payload.data(), length);  // no DataBytes channel: none
   const std::uint64_t bus = bits(c.bus, 1);
   if (bus < 1 || bus > kMaxBusChannel)
     return bad("bus channel " + std::to_string(bus) + " out of 1..99");

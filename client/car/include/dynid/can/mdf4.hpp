@@ -25,7 +25,7 @@
 // kMaxInflatedBytes and at most 1032 times its size (zlib's limit), a cycle count needs the bytes
 // it counts, and the metadata and all the data read (read_records, however often it is called)
 // are at most kMaxBlocks blocks and kMaxDataBytes bytes in all (read_signals starts a budget of
-// its own). Whatever is wrong throws InputError
+// its own); the names and texts kept are at most kMaxTextBytes. Whatever is wrong throws InputError
 // "<file>: offset <n>: <reason>" naming the block's offset. The file is read whole (at most
 // kMaxFileBytes), since links point anywhere in it.
 #include <cstddef>
@@ -147,6 +147,7 @@ class Mdf4File {
   static constexpr std::uint64_t kMaxInflatedBytes = 1ULL << 30;
   static constexpr std::size_t kMaxBlocks = 1U << 20;
   static constexpr std::uint64_t kMaxDataBytes = 4ULL << 30;
+  static constexpr std::uint64_t kMaxTextBytes = 64ULL << 20;
 
   /// Reads and checks the file's metadata (not its data); throws InputError / Mdf4Error.
   explicit Mdf4File(const std::filesystem::path& path);
@@ -226,6 +227,7 @@ class Mdf4File {
   mutable std::vector<std::string> notes_;
   mutable std::size_t blocks_read_ = 0;
   mutable std::uint64_t data_read_ = 0;
+  mutable std::uint64_t text_kept_ = 0;
 };
 
 }  // namespace dynid::can
