@@ -253,12 +253,12 @@ void probe_log(const Options& options, const VehicleProfile& profile) {
 std::string replay_log(const Options& options, CarPipeline& pipe,
                        std::function<void(const ReplayProgress&)> on_progress) {
   LogSource source(replay_paths(options));
-  for (const auto& note : source.notes()) spdlog::info("{}", note);
   ReplayOptions ro;
   ro.speed = options.fast ? 0.0 : options.speed;
   ro.progress_interval = 100ms;  // also how often acknowledgements are taken while replaying
   ro.on_progress = std::move(on_progress);
   const ReplayProgress done = replay(source, pipe, ro);
+  for (const auto& note : source.notes()) spdlog::info("{}", note);  // what was recovered (MDF4)
   log_left_out(pipe);
   if (done.rows > 0)  // where the run's times (row / rate) sit on the log's clock, e.g. to compare with its GNSS
     spdlog::info("grid row 0 is at {:.6f} s of the log's clock", pipe.origin());
