@@ -255,24 +255,14 @@ void Mdf4File::parse() {
     if (group.record_id_size != 0 && group.record_id_size != 1 && group.record_id_size != 2 &&
         group.record_id_size != 4 && group.record_id_size != 8)
       fail(at, "record id size " + std::to_string(group.record_id_size) + " (0, 1, 2, 4 or 8)");
+    std::set<std::uint64_t> record_ids;
     for (std::uint64_t cg_at = dg.link(1); cg_at != 0;) {
       if (!seen.insert(cg_at).second)
         fail(cg_at, "the channel group chain comes back to this ##CG (a cycle)");
       const Block cg = block(cg_at, "CG");
-      if (cg.data_size < 32) fail(cg_at, "##CG block too short");
-      Mdf4ChannelGroup g;
-      g.offset = cg_at;
-      g.name = text(cg.link(2));
-      g.record_id = u64(cg.data);
-      g.cycle_count = u64(cg.data + 8);
-      g.flags = u16(cg.data + 16);
-      g.data_bytes = u32(cg.data + 24);
-      g.inval_bytes = u32(cg.data + 28);
-      std::set<std::uint64_t> channels_seen;
-      parse_channels(cg.link(1), g, 0, channels_seen);
-      for (const auto& other : group.groups)
-        if (group.record_id_size != 0 && other.record_id == g.record_id)
-          fail(cg_at, "record id " + std::to_string(g.record_id) + " used by two channel groups");
+      Mdf4ChannelGroup g = channel_group(cg);
+      if (group.record_id_size != 0 && !record_ids.insert(g.record_id).second)
+        fail(cg_at, "record id " + std::to_string(g.record_id) + " used by two channel groups");
       group.groups.push_back(std::move(g));
       metadata_blocks_.push_back(cg_at);
       cg_at = cg.link(0);
@@ -286,6 +276,22 @@ void Mdf4File::parse() {
     at = dg.link(0);
   }
   std::sort(metadata_blocks_.begin(), metadata_blocks_.end());
+}
+
+// A ##CG and its channels.
+Mdf4ChannelGroup Mdf4File::channel_group(const Block& cg) {
+  if (cg.data_size < 32) fail(cg.offset, "##CG block too short");
+  Mdf4ChannelGroup g;
+  g.offset = cg.offset;
+  g.name = text(cg.link(2));
+  g.record_id = u64(cg.data);
+  g.cycle_count = u64(cg.data + 8);
+  g.flags = u16(cg.data + 16);
+  g.data_bytes = u32(cg.data + 24);
+  g.inval_bytes = u32(cg.data + 28);
+  std::set<std::uint64_t> channels_seen;
+  parse_channels(cg.link(1), g, 0, channels_seen);
+  return g;
 }
 
 void Mdf4File::parse_channels(std::uint64_t first, Mdf4ChannelGroup& group, int depth,

@@ -198,6 +198,7 @@ class Mdf4File {
   Block block(std::uint64_t offset, std::string_view expect = {}) const;
   std::string text(std::uint64_t link) const;
   Mdf4Conversion conversion(std::uint64_t link, int depth) const;
+  Mdf4ChannelGroup channel_group(const Block& cg);
   void parse_channels(std::uint64_t first, Mdf4ChannelGroup& group, int depth,
                       std::set<std::uint64_t>& seen);
   // The data a link leads to (##DT, ##SD, ##DZ, ##DL/##HL lists); last_may_run_on: the last
