@@ -312,6 +312,31 @@ TEST(Mdf4, DataListsAndZippedDataGiveTheFramesOfThePlainData) {
   });
 }
 
+// The record's fields give the frame's: EDL makes it a CAN FD frame with its BRS flag, the bus
+// channel its interface (channel n is can<n-1>). The CANedge logs hold classic frames on channels
+// 1 and 2 only, so the first record of the split is patched.
+TEST(Mdf4, RecordFieldsGiveFdFlagsAndTheInterface) {
+  DYNID_REQUIRE_DIR(mdf4_dir());
+  Bytes bytes = read_bytes(raw_file(kSplit1));
+  const Mdf4File file(bytes, kSplit1);
+  const std::uint64_t record = file.data_groups().front().data_link + 24;
+  const auto plain = read_memory(bytes, "plain.mf4");
+  bytes[record + 13] |= 0x3;  // EDL, BRS
+  bytes[record + 8] =
+      static_cast<std::uint8_t>((bytes[record + 8] & ~0x6) | (3 << 1));  // BusChannel 3
+  const auto patched = read_memory(bytes, "patched.mf4");
+  ASSERT_TRUE(patched.errors.empty());
+  ASSERT_FALSE(plain.frames.front().fd);
+  const Frame& f = patched.frames.front();
+  EXPECT_TRUE(f.fd);
+  EXPECT_EQ(f.fd_flags, Frame::kFdBrs);
+  EXPECT_EQ(f.interface_name(), "can2");
+  EXPECT_EQ(f.id, plain.frames.front().id);
+  EXPECT_EQ(f.extended, plain.frames.front().extended);
+  EXPECT_EQ(f.length, 8);
+  EXPECT_EQ(f.data, plain.frames.front().data);
+}
+
 // Hostile files: each is one clear error naming the file and an offset, in bounded time.
 TEST(Mdf4, HostileFilesAreClearErrorsInBoundedTime) {
   DYNID_REQUIRE_DIR(mdf4_dir());
