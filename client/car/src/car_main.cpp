@@ -1,9 +1,11 @@
-// dynid-car: the car-side client. Reads the CAN bus (SocketCAN) or replays a CAN log (candump,
-// Vector ASC or BLF: can/log_reader.hpp),
+// dynid-car: the car-side client. Reads the CAN bus (SocketCAN) or replays CAN logs (candump,
+// Vector ASC or BLF, ASAM MDF4: can/log_reader.hpp; several files, e.g. the splits of one
+// recording, are merged in time order: log_source.hpp),
 // decodes it with the vehicle profile, cuts chunks, keeps them in the spool and delivers them to
 // the server until it acknowledges them durably (delivery.hpp).
 //
-//   dynid-car --profile deploy/profiles/testcar.toml --cyclone-config deploy/cyclonedds/loopback.xml
+//   dynid-car --profile deploy/profiles/testcar.toml --cyclone-config
+//   deploy/cyclonedds/loopback.xml
 //             --replay can.log --fast [--run ID] [--spool DIR]
 //   dynid-car --profile P --cyclone-config C --can can0
 //   dynid-car --profile P --cyclone-config C          # only deliver what the spool still holds
@@ -71,7 +73,7 @@ struct Options {
   std::string run;
   std::string cyclone_config;
   int domain = 0;
-  std::string replay;
+  std::vector<std::string> replay;  // the logs of one run
   std::string can;
   double speed = 1.0;
   bool fast = false;
@@ -82,6 +84,17 @@ struct Options {
   std::uint64_t max_frames = 0;  // live: stop after this many frames (0: only on a signal)
   std::vector<std::string> sources;  // --source NAME=FILE
 };
+
+// The replayed logs as paths, and as one name for messages ("a.log" or "a.MF4 + b.MF4").
+std::vector<std::filesystem::path> replay_paths(const Options& options) {
+  return {options.replay.begin(), options.replay.end()};
+}
+
+std::string replay_name(const Options& options) {
+  std::string name;
+  for (const auto& r : options.replay) name += (name.empty() ? "" : " + ") + r;
+  return name;
+}
 
 constexpr const char* kLogPattern = "dynid-car %l: %v";
 
@@ -171,7 +184,7 @@ RunSources run_profile(const Options& options) {
       throw dynid::InputError("--source " + dynid::input::printable(s.substr(0, eq)) + " given twice");
   }
   std::optional<LogSource> bus;
-  if (!options.replay.empty()) bus.emplace(options.replay);
+  if (!options.replay.empty()) bus.emplace(replay_paths(options));
   const bool live = options.replay.empty() && !options.can.empty();
   // A second bus live: its interface, given in place of a log (--source chassis=can1).
   const LiveCanOpener open_can = [](const AuxiliarySourceSpec& spec, const std::string& interface, double offset) {
@@ -226,13 +239,13 @@ constexpr std::uint64_t kProbeBytes = 256ull << 20;
 // "<file>: <reason>", with the first bad line's reason when there is one.
 std::string log_problem(const Options& options, const LogSource& source, const std::string& problem) {
   const auto errors = source.errors();
-  return options.replay + ": not a CAN log this profile can use: " + problem +
+  return replay_name(options) + ": not a CAN log this profile can use: " + problem +
          (errors.empty() ? "" : "; first: " + errors.front());
 }
 
 // A file the replay would make nothing of fails here, before any state changes.
 void probe_log(const Options& options, const VehicleProfile& profile) {
-  LogSource source(options.replay, kProbeLines, kProbeBytes);
+  LogSource source(replay_paths(options), kProbeLines, kProbeBytes);
   const std::string problem = replay_problem(probe(source, profile, kProbeLines));
   if (!problem.empty())
     throw dynid::InputError(log_problem(options, source,
@@ -245,12 +258,13 @@ void probe_log(const Options& options, const VehicleProfile& profile) {
 // Returns replay_problem() of the whole log as "<file>: <reason>", or "".
 std::string replay_log(const Options& options, CarPipeline& pipe,
                        std::function<void(const ReplayProgress&)> on_progress) {
-  LogSource source(options.replay);
+  LogSource source(replay_paths(options));
   ReplayOptions ro;
   ro.speed = options.fast ? 0.0 : options.speed;
   ro.progress_interval = 100ms;  // also how often acknowledgements are taken while replaying
   ro.on_progress = std::move(on_progress);
   const ReplayProgress done = replay(source, pipe, ro);
+  for (const auto& note : source.notes()) spdlog::info("{}", note);  // what was recovered (MDF4)
   log_left_out(pipe);
   if (done.rows > 0)  // where the run's times (row / rate) sit on the log's clock, e.g. to compare with its GNSS
     spdlog::info("grid row 0 is at {:.6f} s of the log's clock", pipe.origin());
@@ -341,7 +355,7 @@ struct Session {
 
   void replay_run(const std::string& run) {
     CarPipeline pipe = pipeline(run);
-    source_name = std::filesystem::path(options.replay).filename().string();
+    source_name = LogSource(replay_paths(options)).name();
     unusable_log = replay_log(options, pipe, [&](const ReplayProgress& p) {
       delivery.service(0ms);
       show(p, p.done);
@@ -380,8 +394,8 @@ struct Session {
       // Stop reading rather than drop anything: what is stored is still delivered below.
       spool_full = true;
       display.finish();
-      spdlog::error("{}; stopped reading {} — the rest of the run is not recorded",
-                    e.what(), options.replay.empty() ? options.can : options.replay);
+      spdlog::error("{}; stopped reading {} — the rest of the run is not recorded", e.what(),
+                    options.replay.empty() ? options.can : replay_name(options));
     } catch (const Interrupted&) {
       display.finish();
       spdlog::warn("interrupted: stopped reading; delivering what is stored");
@@ -504,7 +518,13 @@ int main(int argc, char** argv) {
          "(required unless --chunks-out)")
       ->envname("DYNID_CYCLONE_CONFIG");
   app.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 230));
-  auto* replay_opt = app.add_option("--replay", o.replay, "replay this CAN log (candump -l, Vector ASC or BLF, told by its content)")->check(input::input_file("CAN log"));
+  auto* replay_opt =
+      app.add_option(
+             "--replay", o.replay,
+             "replay this CAN log (candump -l, Vector ASC or BLF, ASAM MDF4, told by its content); "
+             "several files (--replay a b, or --replay given again) are one run, merged in time "
+             "order")
+          ->check(input::input_file("CAN log"));
   auto* can_opt = app.add_option("--can", o.can, "read this SocketCAN interface live (e.g. can0)");
   replay_opt->excludes(can_opt);
   auto* speed_opt = app.add_option("--speed", o.speed, "replay speed (1 = real time)")

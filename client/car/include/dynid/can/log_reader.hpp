@@ -1,9 +1,9 @@
 #pragma once
-// LogReader: the frames of a recorded CAN log, whatever its format. Three formats are read:
-// candump -l (candump.hpp), Vector ASC (asc.hpp) and Vector BLF (blf.hpp); open_log() picks the
-// reader from the file's content (BLF starts with "LOGG"; an ASC file's first non-blank line is
-// one of its header keywords; anything else is read as candump, whose reader then names the bad
-// lines).
+// LogReader: the frames of a recorded CAN log, whatever its format. Four formats are read:
+// candump -l (candump.hpp), Vector ASC (asc.hpp), Vector BLF (blf.hpp) and ASAM MDF4 bus logs
+// (mdf4_bus.hpp); open_log() picks the reader from the file's content (BLF starts with "LOGG",
+// MDF4 with "MDF     " or, unfinalized, "UnFinMF "; an ASC file's first non-blank line is one of
+// its header keywords; anything else is read as candump, whose reader then names the bad lines).
 //
 // Contract (every reader): next() never throws for bad data. A bad line or object is counted
 // (error_count()), the first kMaxKeptErrors are kept with where they are (a line number for the
@@ -13,8 +13,8 @@
 // one endless line). Only a file
 // that cannot be opened, or is not a regular file (input/input_file.hpp), throws InputError
 // naming it. Frames come out in file order with their timestamps in seconds on the log's clock;
-// a format that stores the measurement start (ASC, BLF) gives start + offset (see its header).
-// bytes_consumed() is how far into the file the reader is (for progress).
+// a format that stores the measurement start (ASC, BLF, MDF4) gives start + offset (see its
+// header). bytes_consumed() is how far into the file the reader is (for progress).
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -30,13 +30,13 @@
 namespace dynid::can {
 
 struct LogError {
-  std::size_t line = 0;  ///< line number (candump, ASC) or byte offset of the object (BLF)
+  std::size_t line = 0;  ///< line number (candump, ASC) or byte offset of the object (BLF, MDF4)
   std::string reason;
 };
 
 enum class OnError { Continue, Stop };
 
-enum class LogFormat { Candump, Asc, Blf };
+enum class LogFormat { Candump, Asc, Blf, Mdf4 };
 
 std::string_view log_format_name(LogFormat format);
 
@@ -56,7 +56,7 @@ class LogReader {
   std::size_t frame_count() const { return frame_count_; }
   bool stopped() const { return stopped_; }
   const std::string& source() const { return source_; }
-  /// "<source>:<line>: <reason>" (text formats) or "<source>: offset <n>: <reason>" (BLF).
+  /// "<source>:<line>: <reason>" (text formats) or "<source>: offset <n>: <reason>" (BLF, MDF4).
   virtual std::string describe(const LogError& error) const;
   virtual std::uint64_t bytes_consumed() const = 0;
   virtual LogFormat format() const = 0;
