@@ -1,9 +1,10 @@
 // dynid-car: the car-side client. Reads the CAN bus (SocketCAN) or replays a CAN log (candump,
-// Vector ASC or BLF: can/log_reader.hpp),
+// Vector ASC or BLF, PCAN trace: can/log_reader.hpp),
 // decodes it with the vehicle profile, cuts chunks, keeps them in the spool and delivers them to
 // the server until it acknowledges them durably (delivery.hpp).
 //
-//   dynid-car --profile deploy/profiles/testcar.toml --cyclone-config deploy/cyclonedds/loopback.xml
+//   dynid-car --profile deploy/profiles/testcar.toml --cyclone-config
+//   deploy/cyclonedds/loopback.xml
 //             --replay can.log --fast [--run ID] [--spool DIR]
 //   dynid-car --profile P --cyclone-config C --can can0
 //   dynid-car --profile P --cyclone-config C          # only deliver what the spool still holds
@@ -42,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include <dynid/can/log_content.hpp>
 #include <dynid/dds/participant.hpp>
 #include <dynid/error.hpp>
 #include <dynid/options/option_checks.hpp>
@@ -217,19 +219,25 @@ void log_left_out(const CarPipeline& pipe) {
 constexpr std::uint64_t kProbeLines = 10000;
 constexpr std::uint64_t kProbeBytes = 256ull << 20;
 
-// "<file>: <reason>", with the first bad line's reason when there is one.
-std::string log_problem(const Options& options, const LogSource& source, const std::string& problem) {
+// "<file>: <reason>", with what the file looks like when most of it is no frame (a CSV table, a
+// compressed or binary file: can/log_content.hpp) and the first bad line's reason when there is
+// one.
+std::string log_problem(const Options& options, const LogSource& source,
+                        const ReplayProgress& counts, const std::string& problem) {
   const auto errors = source.errors();
+  const std::string looks =
+      mostly_not_frames(counts) ? dynid::can::describe_log_file(options.replay) : "";
   return options.replay + ": not a CAN log this profile can use: " + problem +
-         (errors.empty() ? "" : "; first: " + errors.front());
+         (looks.empty() ? "" : "; " + looks) + (errors.empty() ? "" : "; first: " + errors.front());
 }
 
 // A file the replay would make nothing of fails here, before any state changes.
 void probe_log(const Options& options, const VehicleProfile& profile) {
   LogSource source(options.replay, kProbeLines, kProbeBytes);
-  const std::string problem = replay_problem(probe(source, profile, kProbeLines));
+  const ReplayProgress counts = probe(source, profile, kProbeLines);
+  const std::string problem = replay_problem(counts);
   if (!problem.empty())
-    throw dynid::InputError(log_problem(options, source,
+    throw dynid::InputError(log_problem(options, source, counts,
                                         problem + " in its first " + std::to_string(kProbeLines) +
                                             " lines (at most " + std::to_string(kProbeBytes >> 20) +
                                             " MiB)"));
@@ -254,7 +262,7 @@ std::string replay_log(const Options& options, CarPipeline& pipe,
                pipe.resampler_stats().pieces_ended, done.chunks);
   for (const auto& e : source.errors()) spdlog::warn("{}", e);
   const std::string problem = replay_problem(done);
-  return problem.empty() ? problem : log_problem(options, source, problem);
+  return problem.empty() ? problem : log_problem(options, source, done, problem);
 }
 
 // Reads the bus (options.can, opened by the caller) live into the pipeline until a signal (or
@@ -495,7 +503,11 @@ int main(int argc, char** argv) {
                  "Cyclone DDS configuration: a file (deploy/cyclonedds/*.xml), or file:// URIs and XML "
                  "fragments, comma-separated, as in CYCLONEDDS_URI (required unless --chunks-out)");
   app.add_option("--domain", o.domain, "DDS domain id")->check(CLI::Range(0, 230));
-  auto* replay_opt = app.add_option("--replay", o.replay, "replay this CAN log (candump -l, Vector ASC or BLF, told by its content)")->check(input::input_file("CAN log"));
+  auto* replay_opt =
+      app.add_option(
+             "--replay", o.replay,
+             "replay this CAN log (candump -l, Vector ASC or BLF, PCAN trace, told by its content)")
+          ->check(input::input_file("CAN log"));
   auto* can_opt = app.add_option("--can", o.can, "read this SocketCAN interface live (e.g. can0)");
   replay_opt->excludes(can_opt);
   auto* speed_opt = app.add_option("--speed", o.speed, "replay speed (1 = real time)")

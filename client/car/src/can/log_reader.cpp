@@ -7,6 +7,7 @@
 #include <dynid/can/asc.hpp>
 #include <dynid/can/blf.hpp>
 #include <dynid/can/candump.hpp>
+#include <dynid/can/trc.hpp>
 #include <dynid/error.hpp>
 #include <dynid/input/input_file.hpp>
 
@@ -19,6 +20,8 @@ std::string_view log_format_name(LogFormat format) {
     case LogFormat::Candump: return "candump";
     case LogFormat::Asc: return "Vector ASC";
     case LogFormat::Blf: return "Vector BLF";
+    case LogFormat::Trc:
+      return "PCAN trace";
   }
   return "?";
 }
@@ -31,6 +34,7 @@ LogFormat detect_log_format(const std::filesystem::path& path) {
   in.read(head, sizeof head);
   const auto n = static_cast<std::size_t>(in.gcount());
   if (n >= 4 && std::memcmp(head, "LOGG", 4) == 0) return LogFormat::Blf;
+  if (looks_like_trc(std::string_view(head, n))) return LogFormat::Trc;
   // The first non-blank line of an ASC file is one of its header keywords.
   std::size_t i = 0;
   while (i < n && (head[i] == ' ' || head[i] == '\t' || head[i] == '\r' || head[i] == '\n')) ++i;
@@ -45,6 +49,8 @@ std::unique_ptr<LogReader> open_log(const std::filesystem::path& path, OnError o
   switch (detect_log_format(path)) {
     case LogFormat::Blf: return std::make_unique<BlfReader>(path, on_error);
     case LogFormat::Asc: return std::make_unique<AscReader>(path, on_error);
+    case LogFormat::Trc:
+      return std::make_unique<TrcReader>(path, on_error);
     case LogFormat::Candump: break;
   }
   return std::make_unique<CandumpReader>(path, on_error);

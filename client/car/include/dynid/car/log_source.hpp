@@ -1,7 +1,7 @@
 #pragma once
 // LogSource: a FrameSource over a recorded CAN log of any format can::open_log() reads (candump
-// -l, Vector ASC, Vector BLF: can/log_reader.hpp picks it from the file's content), the replay
-// path of dynid-car --replay.
+// -l, Vector ASC, Vector BLF, PCAN trace: can/log_reader.hpp picks it from the file's content), the
+// replay path of dynid-car --replay.
 //
 // Contract: as CandumpSource's (candump_source.hpp): a bad line or object is counted
 // (bad_input(), the first ones kept in errors() with their line or byte offset) and skipped, never
