@@ -16,7 +16,8 @@ using detail::words;
 
 constexpr std::int64_t kNsPerDay = 86'400'000'000'000LL;
 constexpr std::int64_t kDaysTo1970 = 25569;       // 1899-12-30 to 1970-01-01
-constexpr std::int64_t kDaysTo10000 = 2'958'466;  // 1899-12-30 to 10000-01-01
+// 1899-12-30 to 2200-01-01: start + offset in nanoseconds stays within int64 (to 2262).
+constexpr std::int64_t kDaysTo2200 = 109'575;
 constexpr std::string_view kColumnLetters = "NOTBIdRlLD";
 
 bool starts_with(std::string_view s, std::string_view prefix) {
@@ -114,7 +115,7 @@ std::optional<std::int64_t> parse_trc_start_time(std::string_view days) {
     if (!parse_uint(kept, 10, frac)) return std::nullopt;
     for (std::size_t i = kept.size(); i < 12; ++i) frac *= 10;
   }
-  if (d < kDaysTo1970 || d >= kDaysTo10000) return std::nullopt;
+  if (d < kDaysTo1970 || d >= kDaysTo2200) return std::nullopt;
   // frac / 1e12 days = frac * 8.64e10 / 1e12 us = frac * 864 / 1e4 us, rounded to the microsecond.
   const std::int64_t us = (frac * 864 + 5'000) / 10'000;
   return (d - kDaysTo1970) * kNsPerDay + us * 1000;
@@ -203,7 +204,7 @@ std::string TrcReader::parse_header(std::string_view line) {
     start_ns_ = parse_trc_start_time(header_value(line));
     if (!start_ns_)
       return "bad $STARTTIME " + quoted(header_value(line)) +
-             " (days since 1899-12-30, from 1970 to 9999)";
+             " (days since 1899-12-30, from 1970 to 2199)";
     return {};
   }
   if (starts_with(line, ";$COLUMNS")) return set_columns(header_value(line));

@@ -42,7 +42,8 @@
 namespace dynid::can {
 
 /// Epoch nanoseconds (UTC, rounded to the microsecond) of a $STARTTIME value: days since
-/// 1899-12-30 as "<days>[.<fraction>]", from 1970 to 9999; nullopt otherwise.
+/// 1899-12-30 as "<days>[.<fraction>]", from 1970 to 2199 (as far as start + offset in
+/// nanoseconds fits 64 bits, with room for any offset); nullopt otherwise.
 std::optional<std::int64_t> parse_trc_start_time(std::string_view days);
 
 /// True when `head`, the first bytes of a file, is a PCAN trace: its first non-blank line starts
