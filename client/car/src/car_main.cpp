@@ -475,6 +475,7 @@ int run(const Options& options, ProgressDisplay& display) {
   if (!options.replay.empty() || !options.can.empty()) session.read_source();
   const bool drained = session.drain();
   const auto& s = delivery.stats();
+  for (const std::string& line : delivery.set_aside_report()) spdlog::warn("{}", line);
   if (uplink.bad_receipts() > 0)
     spdlog::warn("{} malformed acknowledgements ignored, last: {}", uplink.bad_receipts(), uplink.last_bad_receipt());
   if (!drained) {
@@ -482,8 +483,11 @@ int run(const Options& options, ProgressDisplay& display) {
                   options.drain_timeout, delivery.holdup(), spool.file().string());
     return session.spool_full ? kSpoolFull : kUndelivered;
   }
-  spdlog::info("all chunks acknowledged: {} stored, {} sent, {} resent in {} rounds, {} rejections", s.submitted,
-               s.sent, s.resent, s.resend_rounds, s.rejections);
+  spdlog::info(
+      "all chunks acknowledged: {} stored, {} sent, {} resent in {} rounds, {} rejections, {} "
+      "chunks "
+      "refused for good and set aside",
+      s.submitted, s.sent, s.resent, s.resend_rounds, s.rejections, s.set_aside);
   if (!session.unusable_log.empty()) {  // what was good is delivered; the job was not done
     spdlog::error("{}", session.unusable_log);
     return kFailed;
