@@ -32,6 +32,19 @@ std::string dbc_error(const std::string& text, const std::string& name) {
   return "(no error)";
 }
 
+std::vector<Frame> read_all(LogReader& reader) {
+  std::vector<Frame> out;
+  Frame f;
+  while (reader.next(f)) out.push_back(f);
+  return out;
+}
+
+std::vector<std::string> described(const LogReader& reader) {
+  std::vector<std::string> out;
+  for (const auto& e : reader.errors()) out.push_back(reader.describe(e));
+  return out;
+}
+
 std::string run_command(const std::string& command, int& status) {
   std::string out;
   FILE* pipe = popen(command.c_str(), "r");

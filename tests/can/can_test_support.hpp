@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include <dynid/can/log_reader.hpp>
+
 namespace dynid::can::test {
 
 std::filesystem::path shared_data();
@@ -15,6 +17,12 @@ std::vector<std::filesystem::path> opendbc_files();
 
 // The message of the InputError that parsing `text` as DBC file `name` throws, or "(no error)".
 std::string dbc_error(const std::string& text, const std::string& name = "bad.dbc");
+
+// Every frame the reader gives, to its end.
+std::vector<Frame> read_all(LogReader& reader);
+
+// The reader's kept errors as describe() says them.
+std::vector<std::string> described(const LogReader& reader);
 
 // Runs a shell command and returns its standard output; sets `status` to the exit code.
 std::string run_command(const std::string& command, int& status);

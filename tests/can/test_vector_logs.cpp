@@ -20,18 +20,8 @@
 namespace dynid::can {
 namespace {
 
-std::vector<Frame> read_all(LogReader& r) {
-  std::vector<Frame> out;
-  Frame f;
-  while (r.next(f)) out.push_back(f);
-  return out;
-}
-
-std::vector<std::string> described(const LogReader& r) {
-  std::vector<std::string> out;
-  for (const auto& e : r.errors()) out.push_back(r.describe(e));
-  return out;
-}
+using test::described;
+using test::read_all;
 
 using ::dynid::test::TempDir;
 

@@ -116,5 +116,57 @@ TEST(DroppedSamples, AChannelThatNeverGetsAValueIsNamed) {
       << report[0];
 }
 
+// The other channel types: a 64-bit integer signal at 2^63 (9.2e18) and a scaled 16-bit one
+// whose factor puts its top value at 6.6e16 go past the limit as the double and the float do:
+// left out where they enter, every chunk one the server takes, each named with its value.
+TEST(DroppedSamples, IntegerAndScaledSignalsPastTheLimitAreLeftOutToo) {
+  test::ScratchDir dir("dropped-integer");
+  const auto dbc = dir.path() / "integer.dbc";
+  std::ofstream(dbc) << "VERSION \"\"\n\nNS_ :\n\nBS_:\n\nBU_: ECU\n\n"
+                        "BO_ 258 Wheel: 8 ECU\n"
+                        " SG_ WhlSpd : 0|64@1+ (1,0) [0|0] \"m/s\" ECU\n\n"
+                        "BO_ 259 Brake: 2 ECU\n"
+                        " SG_ Pressure : 0|16@1+ (1e12,0) [0|0] \"Pa\" ECU\n";
+  const VehicleProfile profile = parse_vehicle_profile(
+      "[vehicle]\nid = \"integer-car\"\ndbc = \"" + dbc.string() +
+          "\"\n[grid]\nrate_hz = 100.0\nchunk_seconds = 1.0\n[spool]\ndirectory = "
+          "\"spool\"\nmax_bytes = 1000000\n"
+          "[[channels]]\nname = \"wheel_speed_fl\"\nmessage = \"Wheel\"\nsignal = \"WhlSpd\"\n"
+          "[[channels]]\nname = \"brake_pressure\"\nmessage = \"Brake\"\nsignal = \"Pressure\"\n",
+      dir.path() / "integer.toml");
+  std::vector<ingest::Chunk> chunks;
+  CarPipeline pipe(profile, "r1", [&](ingest::Chunk&& c) { chunks.push_back(std::move(c)); });
+  for (int i = 0; i < 1000; ++i) {
+    const double t = i * 0.01;
+    const std::uint64_t wheel = i == 300 ? std::uint64_t{1} << 63 : 20;
+    const std::uint16_t pressure = i == 500 ? 0xFFFF : 0;
+    pipe.on_frame(frame(258, t, &wheel, 8));
+    pipe.on_frame(frame(259, t + 0.001, &pressure, 2));
+  }
+  pipe.finish();
+  const ingest::RunAnnouncement announcement = profile.announcement("r1");
+  std::size_t rows = 0;
+  for (const ingest::Chunk& c : chunks) {
+    EXPECT_NO_THROW(ingest::validate_and_encode(c, announcement, ingest::ChunkLimits{}))
+        << c.sequence;
+    rows += static_cast<std::size_t>(c.samples.rows());
+  }
+  EXPECT_GE(rows, 990U);
+  EXPECT_EQ(pipe.mapper_stats().out_of_range, 2U);
+  const std::vector<std::string> report = pipe.dropped_report();
+  ASSERT_EQ(report.size(), 2U) << ::testing::PrintToString(report);
+  const std::string both = report[0] + "\n" + report[1];
+  EXPECT_NE(both.find("channel 'wheel_speed_fl': 1 sample left out (the first 9.22e+18, beyond the "
+                      "1e+15 a chunk "
+                      "may carry, at 3.000 s"),
+            std::string::npos)
+      << both;
+  EXPECT_NE(both.find("channel 'brake_pressure': 1 sample left out (the first 6.55e+16, beyond the "
+                      "1e+15 a chunk "
+                      "may carry, at 5.001 s"),
+            std::string::npos)
+      << both;
+}
+
 }  // namespace
 }  // namespace dynid::car

@@ -2,6 +2,7 @@
 // the unacknowledged ones in order, and a full spool says so instead of dropping anything.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -133,6 +134,42 @@ TEST(CarSpool, AFullSpoolSaysSoAndDropsNothing) {
   spool.acknowledge("car-1", "r", 0);
   EXPECT_NO_THROW(spool.store(chunks[4]));
   EXPECT_EQ(sequences(spool), (std::vector<std::uint64_t>{1, 2, 3, 4}));
+}
+
+// A chunk set aside (refused for good by the server) keeps its bytes and reason in the refused
+// table, its stand-in takes its place in order; a run set aside leaves nothing to resend, and
+// both survive a restart.
+TEST(CarSpool, SetAsideKeepsTheRefusedChunkAndPutsItsStandInInItsPlace) {
+  test::ScratchDir dir("spool-set-aside");
+  const auto chunks = make_chunks("r1", 3);
+  const auto other = make_chunks("r2", 2);
+  {
+    Spool spool(dir.path(), 1 << 20);
+    for (const auto& c : chunks) spool.store(c);
+    for (const auto& c : other) spool.store(c);
+    ingest::Chunk stand_in = chunks[1];
+    stand_in.samples.setZero();
+    std::fill(stand_in.valid.begin(), stand_in.valid.end(), std::uint8_t{0});
+    stand_in.seal();
+    spool.set_aside(stand_in, "value past the limit");
+    EXPECT_EQ(sequences(spool), (std::vector<std::uint64_t>{0, 1, 2, 0, 1}));
+    expect_same(*spool.load("car-1", "r1", 1), stand_in);
+    ingest::Chunk missing = stand_in;
+    missing.sequence = 9;
+    EXPECT_THROW(spool.set_aside(missing, "x"), InputError);
+    EXPECT_EQ(spool.set_aside_run("car-1", "r2", "run name taken"), 2U);
+    EXPECT_EQ(sequences(spool), (std::vector<std::uint64_t>{0, 1, 2}));
+    EXPECT_EQ(spool.bytes(), 3 * ingest::encode_chunk(chunks[0]).size());
+  }
+  Spool again(dir.path(), 1 << 20);
+  const auto refused = again.refused();
+  ASSERT_EQ(refused.size(), 3U);
+  EXPECT_EQ(refused[0].run, "r1");
+  EXPECT_EQ(refused[0].sequence, 1U);
+  EXPECT_EQ(refused[0].reason, "value past the limit");
+  EXPECT_EQ(refused[1].run, "r2");
+  EXPECT_EQ(refused[2].reason, "run name taken");
+  EXPECT_EQ(sequences(again), (std::vector<std::uint64_t>{0, 1, 2}));
 }
 
 }  // namespace

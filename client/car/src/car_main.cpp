@@ -1,6 +1,6 @@
 // dynid-car: the car-side client. Reads the CAN bus (SocketCAN) or replays CAN logs (candump,
-// Vector ASC or BLF, ASAM MDF4: can/log_reader.hpp; several files, e.g. the splits of one
-// recording, are merged in time order: log_source.hpp),
+// Vector ASC or BLF, PCAN trace, ASAM MDF4: can/log_reader.hpp; several files, e.g. the splits of
+// one recording, are merged in time order: log_source.hpp),
 // decodes it with the vehicle profile, cuts chunks, keeps them in the spool and delivers them to
 // the server until it acknowledges them durably (delivery.hpp).
 //
@@ -44,6 +44,7 @@
 #include <string>
 #include <vector>
 
+#include <dynid/can/log_content.hpp>
 #include <dynid/dds/participant.hpp>
 #include <dynid/error.hpp>
 #include <dynid/options/option_checks.hpp>
@@ -236,19 +237,29 @@ void log_left_out(const CarPipeline& pipe) {
 constexpr std::uint64_t kProbeLines = 10000;
 constexpr std::uint64_t kProbeBytes = 256ull << 20;
 
-// "<file>: <reason>", with the first bad line's reason when there is one.
-std::string log_problem(const Options& options, const LogSource& source, const std::string& problem) {
+// "<file>: <reason>", with what the file looks like when most of it is no frame (a CSV table, a
+// compressed or binary file: can/log_content.hpp) and the first bad line's reason when there is
+// one.
+std::string log_problem(const Options& options, const LogSource& source,
+                        const ReplayProgress& counts, const std::string& problem) {
   const auto errors = source.errors();
+  // What each file looks like when most of the replay is no frame (a single file: no prefix).
+  std::string looks;
+  if (mostly_not_frames(counts))
+    for (const std::string& file : options.replay)
+      if (const std::string d = dynid::can::describe_log_file(file); !d.empty())
+        looks += (looks.empty() ? "" : "; ") + (options.replay.size() > 1 ? file + ": " : "") + d;
   return replay_name(options) + ": not a CAN log this profile can use: " + problem +
-         (errors.empty() ? "" : "; first: " + errors.front());
+         (looks.empty() ? "" : "; " + looks) + (errors.empty() ? "" : "; first: " + errors.front());
 }
 
 // A file the replay would make nothing of fails here, before any state changes.
 void probe_log(const Options& options, const VehicleProfile& profile) {
   LogSource source(replay_paths(options), kProbeLines, kProbeBytes);
-  const std::string problem = replay_problem(probe(source, profile, kProbeLines));
+  const ReplayProgress counts = probe(source, profile, kProbeLines);
+  const std::string problem = replay_problem(counts);
   if (!problem.empty())
-    throw dynid::InputError(log_problem(options, source,
+    throw dynid::InputError(log_problem(options, source, counts,
                                         problem + " in its first " + std::to_string(kProbeLines) +
                                             " lines (at most " + std::to_string(kProbeBytes >> 20) +
                                             " MiB)"));
@@ -274,7 +285,7 @@ std::string replay_log(const Options& options, CarPipeline& pipe,
                pipe.resampler_stats().pieces_ended, done.chunks);
   for (const auto& e : source.errors()) spdlog::warn("{}", e);
   const std::string problem = replay_problem(done);
-  return problem.empty() ? problem : log_problem(options, source, problem);
+  return problem.empty() ? problem : log_problem(options, source, done, problem);
 }
 
 // Reads the bus (options.can, opened by the caller) live into the pipeline until a signal (or
@@ -487,6 +498,7 @@ int run(const Options& options, ProgressDisplay& display) {
   if (!options.replay.empty() || !options.can.empty()) session.read_source();
   const bool drained = session.drain();
   const auto& s = delivery.stats();
+  for (const std::string& line : delivery.set_aside_report()) spdlog::warn("{}", line);
   if (uplink.bad_receipts() > 0)
     spdlog::warn("{} malformed acknowledgements ignored, last: {}", uplink.bad_receipts(), uplink.last_bad_receipt());
   if (!drained) {
@@ -494,8 +506,11 @@ int run(const Options& options, ProgressDisplay& display) {
                   options.drain_timeout, delivery.holdup(), spool.file().string());
     return session.spool_full ? kSpoolFull : kUndelivered;
   }
-  spdlog::info("all chunks acknowledged: {} stored, {} sent, {} resent in {} rounds, {} rejections", s.submitted,
-               s.sent, s.resent, s.resend_rounds, s.rejections);
+  spdlog::info(
+      "all chunks acknowledged: {} stored, {} sent, {} resent in {} rounds, {} rejections, {} "
+      "chunks "
+      "refused for good and set aside",
+      s.submitted, s.sent, s.resent, s.resend_rounds, s.rejections, s.set_aside);
   if (!session.unusable_log.empty()) {  // what was good is delivered; the job was not done
     spdlog::error("{}", session.unusable_log);
     return kFailed;
@@ -521,9 +536,9 @@ int main(int argc, char** argv) {
   auto* replay_opt =
       app.add_option(
              "--replay", o.replay,
-             "replay this CAN log (candump -l, Vector ASC or BLF, ASAM MDF4, told by its content); "
-             "several files (--replay a b, or --replay given again) are one run, merged in time "
-             "order")
+             "replay this CAN log (candump -l, Vector ASC or BLF, PCAN trace, ASAM MDF4, told by "
+             "its content); several files (--replay a b, or --replay given again) are one run, "
+             "merged in time order")
           ->check(input::input_file("CAN log"));
   auto* can_opt = app.add_option("--can", o.can, "read this SocketCAN interface live (e.g. can0)");
   replay_opt->excludes(can_opt);

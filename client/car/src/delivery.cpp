@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <dynid/ingest/refusals.hpp>
+
 #include "dynid/dds/protocol.hpp"
 
 namespace dynid::car {
@@ -35,6 +37,8 @@ Delivery::Delivery(Spool& spool, Uplink& uplink, DeliveryOptions options, Delive
   for (const auto& e : spool_.pending_entries()) {
     own_runs_.insert({e.vehicle, e.run});
     queue_.push_back({e.vehicle, e.run, e.sequence, true});
+    auto& sent = sent_through_[{e.vehicle, e.run}];  // an earlier process may have sent it
+    sent = std::max(sent, e.sequence);
   }
   if (!queue_.empty())
     log(LogLevel::info, "resuming: " + std::to_string(queue_.size()) + " unacknowledged chunks in the spool (" +
@@ -160,6 +164,15 @@ bool Delivery::on_receipt(const dds::ChunkReceipt& receipt) {
   if (own_runs_.count({receipt.vehicle, receipt.run}) == 0) return false;  // another car's run
   bool pending_rejected = false;
   for (const auto& r : receipt.rejections) {
+    // Other content under this run's name is never history: the server's mark is not this
+    // car's, so it is refused before the mark is taken.
+    if (r.sequence != kAnnouncementSequence &&
+        r.reason.find(ingest::kStoredWithOtherContent) != std::string::npos) {
+      ++stats_.rejections;
+      log(LogLevel::warning,
+          "server rejected " + name_of(receipt.vehicle, receipt.run, r.sequence) + ": " + r.reason);
+      refuse_run(receipt.vehicle, receipt.run, r.reason);
+    }
     // Rejections of chunks acknowledged since (a resend went through) are history.
     const bool settled = r.sequence != kAnnouncementSequence && receipt.highest_contiguous >= 0 &&
                          r.sequence <= static_cast<std::uint64_t>(receipt.highest_contiguous);
@@ -167,13 +180,72 @@ bool Delivery::on_receipt(const dds::ChunkReceipt& receipt) {
     ++stats_.rejections;
     rejected_[{receipt.run, r.sequence}] = r.reason;
     log(LogLevel::warning, "server rejected " + name_of(receipt.vehicle, receipt.run, r.sequence) + ": " + r.reason);
-    pending_rejected = pending_rejected || std::any_of(queue_.begin(), queue_.end(), [&](const Entry& e) {
-                         return e.vehicle == receipt.vehicle && e.run == receipt.run && e.sequence == r.sequence;
-                       });
+    const auto pending = std::find_if(queue_.begin(), queue_.end(), [&](const Entry& e) {
+      return e.vehicle == receipt.vehicle && e.run == receipt.run && e.sequence == r.sequence;
+    });
+    if (pending == queue_.end()) continue;
+    pending_rejected = true;
+    set_aside_if_refused(*pending, r.reason);
   }
-  if (receipt.highest_contiguous >= 0)
-    acknowledge(receipt.vehicle, receipt.run, static_cast<std::uint64_t>(receipt.highest_contiguous));
+  // Never past what this car sent: a chunk not sent yet cannot be the server's.
+  const auto sent = sent_through_.find({receipt.vehicle, receipt.run});
+  if (receipt.highest_contiguous >= 0 && sent != sent_through_.end())
+    acknowledge(receipt.vehicle, receipt.run,
+                std::min(static_cast<std::uint64_t>(receipt.highest_contiguous), sent->second));
   return pending_rejected;
+}
+
+void Delivery::set_aside_if_refused(const Entry& entry, const std::string& reason) {
+  const auto announcement = spool_.announcement(entry.vehicle, entry.run);
+  const auto chunk = spool_.load(entry.vehicle, entry.run, entry.sequence);
+  if (!announcement || !chunk) return;  // nothing to check it against: resent as before
+  try {
+    ingest::validate_chunk(*chunk, *announcement);
+    return;  // the rule takes it: the refusal may pass (it overtook its announcement, a full
+             // window)
+  } catch (const InputError&) {
+  }
+  ingest::Chunk stand_in = *chunk;
+  stand_in.samples.setZero();
+  std::fill(stand_in.valid.begin(), stand_in.valid.end(), std::uint8_t{0});
+  stand_in.seal();
+  try {
+    ingest::validate_chunk(stand_in, *announcement);
+  } catch (const InputError&) {
+    return;  // its shape is wrong too: nothing can take its place, it holds the run as before
+  }
+  spool_.set_aside(stand_in, reason);
+  rejected_.erase({entry.run, entry.sequence});  // what is pending now is the stand-in
+  ++stats_.set_aside;
+  const auto rows = static_cast<std::uint64_t>(chunk->samples.rows());
+  const std::string line = name_of(entry.vehicle, entry.run, entry.sequence) + " (samples " +
+                           std::to_string(chunk->first_sample_index) + ".." +
+                           std::to_string(chunk->first_sample_index + rows - 1) +
+                           ") refused for good by the server: " + reason +
+                           "; set aside in the spool " + spool_.file().string() + ", its " +
+                           std::to_string(rows) +
+                           " rows sent as invalid in its place so the run's later chunks go on";
+  set_aside_.push_back(line);
+  log(LogLevel::warning, line);
+}
+
+void Delivery::refuse_run(const std::string& vehicle, const std::string& run,
+                          const std::string& reason) {
+  const auto of_run = [&](const Entry& e) { return e.vehicle == vehicle && e.run == run; };
+  sent_ -= static_cast<std::size_t>(
+      std::count_if(queue_.begin(), queue_.begin() + static_cast<std::ptrdiff_t>(sent_), of_run));
+  std::erase_if(queue_, of_run);
+  std::erase_if(held_, [&](const ingest::Chunk& c) {
+    if (c.vehicle != vehicle || c.run != run) return false;
+    held_bytes_ -= held_size(c);
+    return true;
+  });
+  const std::size_t moved = spool_.set_aside_run(vehicle, run, reason);
+  throw RunRefused(
+      "the server refused run " + vehicle + "/" + run + ": " + reason +
+      ": its name holds another recording's chunks; replay this one under another --run (its " +
+      std::to_string(moved) + " chunks are set aside in the spool " + spool_.file().string() +
+      ", not resent)");
 }
 
 void Delivery::acknowledge(const std::string& vehicle, const std::string& run, std::uint64_t through) {
@@ -223,6 +295,8 @@ void Delivery::pump() {
       return;
     }
     if (sent_ == 0) last_progress_ = Clock::now();  // the ack timeout runs from the first send
+    auto& through = sent_through_[{e.vehicle, e.run}];
+    through = std::max(through, e.sequence);
     ++(e.sent_before ? stats_.resent : stats_.sent);
     e.sent_before = true;
     ++sent_;

@@ -72,10 +72,14 @@ std::string replay_problem(const ReplayProgress& c) {
     return "none of its " + std::to_string(c.frames) + " frames gives a channel of the profile (" +
            std::to_string(c.decoded) + " decoded by its DBC, " + std::to_string(c.unknown_id) + " unknown ids, " +
            std::to_string(c.other_interface) + " of other interfaces)";
-  if (c.bad_lines > c.frames)
+  if (mostly_not_frames(c))
     return "most lines or objects are not CAN frames (" + std::to_string(c.bad_lines) + " bad lines, " +
            std::to_string(c.frames) + " frames)";
   return "";
+}
+
+bool mostly_not_frames(const ReplayProgress& c) {
+  return c.frames == 0 || c.bad_lines > c.frames;
 }
 
 ReplayProgress probe(FrameSource& source, const VehicleProfile& profile, std::uint64_t lines) {

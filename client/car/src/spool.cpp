@@ -24,6 +24,14 @@ CREATE TABLE IF NOT EXISTS acks (
   run      TEXT NOT NULL,
   sequence INTEGER NOT NULL,
   PRIMARY KEY (vehicle, run));
+CREATE TABLE IF NOT EXISTS refused (
+  vehicle    TEXT NOT NULL,
+  run        TEXT NOT NULL,
+  sequence   INTEGER NOT NULL,
+  refused_at INTEGER NOT NULL,                  -- unix seconds
+  reason     TEXT NOT NULL,
+  data       BLOB NOT NULL,                     -- the chunk as the server refused it
+  PRIMARY KEY (vehicle, run, sequence));
 CREATE TABLE IF NOT EXISTS announcements (
   vehicle  TEXT NOT NULL,
   run      TEXT NOT NULL,
@@ -127,9 +135,7 @@ Spool::Spool(const std::filesystem::path& directory, std::uint64_t max_bytes)
     // FULL: a commit is fsynced before store()/acknowledge() return, also in WAL mode.
     exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL; PRAGMA busy_timeout=5000;");
     exec(kSchema);
-    Statement s(db_, "SELECT COALESCE(SUM(LENGTH(data)), 0) FROM chunks");
-    s.step();
-    bytes_ = s.u64(0);
+    recount();
   } catch (...) {
     sqlite3_close(db_);
     throw;
@@ -199,9 +205,95 @@ void Spool::acknowledge(const std::string& vehicle, const std::string& run, std:
     sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
     throw;
   }
+  recount();
+}
+
+void Spool::recount() {
   Statement s(db_, "SELECT COALESCE(SUM(LENGTH(data)), 0) FROM chunks");
   s.step();
   bytes_ = s.u64(0);
+}
+
+void Spool::set_aside(const ingest::Chunk& stand_in, const std::string& reason) {
+  const std::string name = chunk_name(stand_in.vehicle, stand_in.run, stand_in.sequence);
+  const std::string bytes = ingest::encode_chunk(stand_in);
+  exec("BEGIN IMMEDIATE");
+  try {
+    // OR IGNORE: a chunk set aside twice keeps the bytes first refused.
+    Statement m(db_,
+                "INSERT OR IGNORE INTO refused (vehicle, run, sequence, refused_at, reason, data) "
+                "SELECT vehicle, run, sequence, ?4, ?5, data FROM chunks "
+                "WHERE vehicle = ?1 AND run = ?2 AND sequence = ?3");
+    m.bind(1, stand_in.vehicle)
+        .bind(2, stand_in.run)
+        .bind(3, stand_in.sequence)
+        .bind(4, now_unix())
+        .bind(5, reason);
+    m.step();
+    Statement u(db_,
+                "UPDATE chunks SET data = ?4 WHERE vehicle = ?1 AND run = ?2 AND sequence = ?3");
+    u.bind(1, stand_in.vehicle)
+        .bind(2, stand_in.run)
+        .bind(3, stand_in.sequence)
+        .bind_blob(4, bytes);
+    u.step();
+    if (sqlite3_changes(db_) == 0)
+      throw InputError("spool: chunk " + name + " is not in the spool to set aside");
+    exec("COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+  recount();
+}
+
+std::size_t Spool::set_aside_run(const std::string& vehicle, const std::string& run,
+                                 const std::string& reason) {
+  std::size_t moved = 0;
+  exec("BEGIN IMMEDIATE");
+  try {
+    Statement m(
+        db_,
+        "INSERT OR IGNORE INTO refused (vehicle, run, sequence, refused_at, reason, data) "
+        "SELECT vehicle, run, sequence, ?3, ?4, data FROM chunks WHERE vehicle = ?1 AND run = ?2");
+    m.bind(1, vehicle).bind(2, run).bind(3, now_unix()).bind(4, reason);
+    m.step();
+    Statement d(db_, "DELETE FROM chunks WHERE vehicle = ?1 AND run = ?2");
+    d.bind(1, vehicle).bind(2, run);
+    d.step();
+    moved = static_cast<std::size_t>(sqlite3_changes(db_));
+    Statement a(db_, "DELETE FROM announcements WHERE vehicle = ?1 AND run = ?2");
+    a.bind(1, vehicle).bind(2, run);
+    a.step();
+    exec("COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+  recount();
+  return moved;
+}
+
+std::vector<RefusedEntry> Spool::refused() const {
+  std::vector<RefusedEntry> out;
+  Statement s(db_,
+              "SELECT vehicle, run, sequence, reason FROM refused ORDER BY refused_at, vehicle, "
+              "run, sequence");
+  while (s.step()) out.push_back({s.text(0), s.text(1), s.u64(2), s.text(3)});
+  return out;
+}
+
+std::optional<ingest::RunAnnouncement> Spool::announcement(const std::string& vehicle,
+                                                           const std::string& run) const {
+  Statement s(db_, "SELECT data FROM announcements WHERE vehicle = ?1 AND run = ?2");
+  s.bind(1, vehicle).bind(2, run);
+  if (!s.step()) return std::nullopt;
+  try {
+    return ingest::decode_announcement(s.blob(0));
+  } catch (const InputError& e) {
+    throw InputError("spool " + file_.string() + ": announcement of " + vehicle + "/" + run +
+                     " is corrupted: " + e.what());
+  }
 }
 
 std::optional<std::uint64_t> Spool::acknowledged(const std::string& vehicle, const std::string& run) const {

@@ -4,6 +4,7 @@
 
 #include "chunk_stream_impl.hpp"
 #include "dynid/ingest/chunk.hpp"
+#include "dynid/ingest/refusals.hpp"
 #include "store_impl.hpp"
 #include "support.hpp"
 
@@ -65,7 +66,7 @@ StoreChunkResult Store::Impl::store_valid(const detail::RunRow& run, const inges
   if (const auto stored = stored_bytes(*s.backend, run.id, chunk.sequence)) {
     if (*stored == bytes) return {ChunkStatus::duplicate, from_db(ledger.contiguous), {}};
     return {ChunkStatus::conflict, from_db(ledger.contiguous),
-            "chunk " + label + " is already stored with other content"};
+            "chunk " + label + " " + std::string(ingest::kStoredWithOtherContent)};
   }
   if (run.closed || ledger.closed) throw InputError("chunk " + label + ": the run is closed");
   if (!within_window(chunk.sequence, ledger.contiguous, s.options.reorder_window)) {

@@ -1,41 +1,22 @@
 #include <dynid/can/asc.hpp>
 
 #include <array>
-#include <cctype>
-#include <charconv>
 
 #include "log_text.hpp"
 
 namespace dynid::can {
 namespace {
 
+using detail::iequals;
 using detail::next_word;
+using detail::parse_uint;
 using detail::quoted;
 using detail::trim;
-
-std::vector<std::string_view> words(std::string_view s) {
-  std::vector<std::string_view> out;
-  for (std::string_view w = next_word(s); !w.empty(); w = next_word(s)) out.push_back(w);
-  return out;
-}
-
-bool iequals(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
-  return true;
-}
+using detail::words;
 
 bool starts_with_word(std::string_view line, std::string_view word) {
   std::string_view rest = line;
   return iequals(next_word(rest), word);
-}
-
-template <typename T>
-bool parse_uint(std::string_view s, int base, T& out) {
-  if (s.empty()) return false;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out, base);
-  return ec == std::errc() && end == s.data() + s.size();
 }
 
 // "<seconds>[.<up to 9 digits>]" -> nanoseconds.

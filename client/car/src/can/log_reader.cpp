@@ -8,6 +8,7 @@
 #include <dynid/can/blf.hpp>
 #include <dynid/can/candump.hpp>
 #include <dynid/can/mdf4_bus.hpp>
+#include <dynid/can/trc.hpp>
 #include <dynid/error.hpp>
 #include <dynid/input/input_file.hpp>
 
@@ -22,6 +23,8 @@ std::string_view log_format_name(LogFormat format) {
     case LogFormat::Blf: return "Vector BLF";
     case LogFormat::Mdf4:
       return "ASAM MDF4";
+    case LogFormat::Trc:
+      return "PCAN trace";
   }
   return "?";
 }
@@ -36,6 +39,7 @@ LogFormat detect_log_format(const std::filesystem::path& path) {
   if (n >= 4 && std::memcmp(head, "LOGG", 4) == 0) return LogFormat::Blf;
   if (n >= 8 && (std::memcmp(head, "MDF     ", 8) == 0 || std::memcmp(head, "UnFinMF ", 8) == 0))
     return LogFormat::Mdf4;
+  if (looks_like_trc(std::string_view(head, n))) return LogFormat::Trc;
   // The first non-blank line of an ASC file is one of its header keywords.
   std::size_t i = 0;
   while (i < n && (head[i] == ' ' || head[i] == '\t' || head[i] == '\r' || head[i] == '\n')) ++i;
@@ -52,6 +56,8 @@ std::unique_ptr<LogReader> open_log(const std::filesystem::path& path, OnError o
     case LogFormat::Asc: return std::make_unique<AscReader>(path, on_error);
     case LogFormat::Mdf4:
       return std::make_unique<Mdf4BusReader>(path, on_error);
+    case LogFormat::Trc:
+      return std::make_unique<TrcReader>(path, on_error);
     case LogFormat::Candump: break;
   }
   return std::make_unique<CandumpReader>(path, on_error);

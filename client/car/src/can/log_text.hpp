@@ -1,9 +1,13 @@
 #pragma once
-// Private helpers of the log readers (candump, ASC, BLF): words of a text line, text of a log
-// shown in a message, civil dates.
+// Private helpers of the log readers (candump, ASC, BLF, TRC): words of a text line, numbers in
+// them, text of a log shown in a message, civil dates.
+#include <cctype>
+#include <charconv>
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <system_error>
+#include <vector>
 
 #include <dynid/input/ids.hpp>
 
@@ -25,6 +29,32 @@ inline std::string_view next_word(std::string_view& s) {
   const std::string_view w = s.substr(0, n);
   s.remove_prefix(n);
   return w;
+}
+
+/// The blank-separated words of `s`.
+inline std::vector<std::string_view> words(std::string_view s) {
+  std::vector<std::string_view> out;
+  for (std::string_view w = next_word(s); !w.empty(); w = next_word(s)) out.push_back(w);
+  return out;
+}
+
+/// Equal but for the case of ASCII letters.
+inline bool iequals(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::tolower(static_cast<unsigned char>(a[i])) !=
+        std::tolower(static_cast<unsigned char>(b[i])))
+      return false;
+  return true;
+}
+
+/// All of `s` as an unsigned number in `base` (no sign, no prefix); false when it is not one or
+/// does not fit.
+template <typename T>
+bool parse_uint(std::string_view s, int base, T& out) {
+  if (s.empty()) return false;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out, base);
+  return ec == std::errc() && end == s.data() + s.size();
 }
 
 /// Escaped: a log's bytes reach messages and log lines (input/ids.hpp printable()).

@@ -1,9 +1,12 @@
 #pragma once
 // LogReader: the frames of a recorded CAN log, whatever its format. Four formats are read:
-// candump -l (candump.hpp), Vector ASC (asc.hpp), Vector BLF (blf.hpp) and ASAM MDF4 bus logs
-// (mdf4_bus.hpp); open_log() picks the reader from the file's content (BLF starts with "LOGG",
-// MDF4 with "MDF     " or, unfinalized, "UnFinMF "; an ASC file's first non-blank line is one of
-// its header keywords; anything else is read as candump, whose reader then names the bad lines).
+// candump -l (candump.hpp), Vector ASC (asc.hpp), Vector BLF (blf.hpp), PEAK PCAN traces
+// (trc.hpp) and ASAM MDF4 bus logs (mdf4_bus.hpp); open_log() picks the reader from the file's
+// content (BLF starts with "LOGG", MDF4 with "MDF     " or, unfinalized, "UnFinMF "; a PCAN
+// trace's first line is ";$FILEVERSION=" or its header comment names PCAN; an ASC file's first
+// non-blank line is one of its header keywords; anything else is read as candump, whose reader
+// then names the bad lines, and a replay refusing a file of mostly bad lines says what the file
+// looks like: log_content.hpp).
 //
 // Contract (every reader): next() never throws for bad data. A bad line or object is counted
 // (error_count()), the first kMaxKeptErrors are kept with where they are (a line number for the
@@ -13,8 +16,8 @@
 // one endless line). Only a file
 // that cannot be opened, or is not a regular file (input/input_file.hpp), throws InputError
 // naming it. Frames come out in file order with their timestamps in seconds on the log's clock;
-// a format that stores the measurement start (ASC, BLF, MDF4) gives start + offset (see its
-// header). bytes_consumed() is how far into the file the reader is (for progress).
+// a format that stores the measurement start (ASC, BLF, TRC, MDF4) gives start + offset (see
+// its header). bytes_consumed() is how far into the file the reader is (for progress).
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -30,13 +33,13 @@
 namespace dynid::can {
 
 struct LogError {
-  std::size_t line = 0;  ///< line number (candump, ASC) or byte offset of the object (BLF, MDF4)
+  std::size_t line = 0;  ///< line number (text formats) or byte offset of the object (BLF, MDF4)
   std::string reason;
 };
 
 enum class OnError { Continue, Stop };
 
-enum class LogFormat { Candump, Asc, Blf, Mdf4 };
+enum class LogFormat { Candump, Asc, Blf, Trc, Mdf4 };
 
 std::string_view log_format_name(LogFormat format);
 
@@ -82,7 +85,7 @@ class LogReader {
   std::uint64_t max_bytes_ = static_cast<std::uint64_t>(-1);
 };
 
-/// A log of text lines (candump, ASC). A line of more than max_line_bytes is no frame of any
+/// A log of text lines (candump, ASC, TRC). A line of more than max_line_bytes is no frame of any
 /// format: it is one bad line ("line of <n> bytes ..."), whatever its length, and is skipped to
 /// its end in pieces, so memory does not grow with it (a look at a file bounded by
 /// stop_after_bytes stops inside an endless line). Blank lines are skipped.

@@ -30,6 +30,22 @@
 //   (b) a new chunk reader matched (a server started or restarted and missed the volatile
 //   chunks), or (c) a new rejection named a chunk still in the spool (e.g. it overtook its run's
 //   announcement; a rejection that repeats with the same reason does not trigger it again).
+// - A chunk the server refuses for good never holds up the chunks after it. A rejection of a
+//   pending chunk is checked with the server's own rule (ingest::validate_chunk against the
+//   run's stored announcement): when the chunk breaks it (a value past the limit, NaN, a bad
+//   shape or checksum), no resend can ever be accepted, so the chunk is set aside in the spool
+//   (Spool::set_aside: kept with the reason) and a stand-in takes its place and is sent: the same
+//   sequence and rows, every value 0 and every row invalid. The server stores the stand-in, its
+//   ledger stays contiguous and holds the refused rows as a gap of invalid rows (as a dropout of
+//   the bus), and the run's later chunks are stored and folded. set_aside_report() names each
+//   such chunk, its rows and the reason. A rejection the rule does not confirm (the chunk
+//   overtook its announcement, the server's window was full) is resent as before.
+// - A run whose name the server holds with other content (a rejection saying
+//   ingest::kStoredWithOtherContent) cannot be delivered under that name: its chunks are set
+//   aside in the spool (Spool::set_aside_run: kept, never resent) and service() throws RunRefused
+//   with the server's reason. Acknowledgements never reach past the highest sequence this car
+//   has sent of a run: the server's mark for a name taken by another recording counts that
+//   recording's chunks, not this car's.
 // - server_knows() tells whether the server published any receipt for the run: it does when it
 //   accepts an announcement, so a replay can wait for it before sending the run's chunks.
 // - drain() services until the spool holds nothing or `timeout` passes; returns drained().
@@ -44,11 +60,20 @@
 #include <string>
 #include <tuple>
 #include <utility>
+#include <vector>
+
+#include <dynid/error.hpp>
 
 #include "dynid/car/spool.hpp"
 #include "dynid/car/uplink.hpp"
 
 namespace dynid::car {
+
+/// The server cannot take a run of this car: its name holds another recording's chunks.
+class RunRefused : public InputError {
+ public:
+  using InputError::InputError;
+};
 
 enum class LogLevel { info, warning, error };
 using DeliveryLog = std::function<void(LogLevel, const std::string&)>;
@@ -68,6 +93,7 @@ struct DeliveryStats {
   std::uint64_t blocked = 0;       ///< sends refused because the server's queue stayed full
   std::uint64_t rejections = 0;    ///< distinct rejections reported by the server
   std::uint64_t held = 0;          ///< chunks held in memory while the spool could not store
+  std::uint64_t set_aside = 0;     ///< chunks refused for good, set aside and sent as invalid rows
 };
 
 class Delivery {
@@ -90,6 +116,9 @@ class Delivery {
   /// Why the oldest pending chunk is not acknowledged, as far as the car knows (a rejection's
   /// reason, or that no server matched), for the final message; empty when drained.
   std::string holdup() const;
+  /// One line per chunk refused for good and set aside by this process: which chunk, its rows
+  /// and samples, the server's reason, and what was sent in its place.
+  const std::vector<std::string>& set_aside_report() const { return set_aside_; }
 
  private:
   struct Entry {
@@ -103,6 +132,11 @@ class Delivery {
   /// True when the receipt brings a new rejection of a chunk still in the spool.
   bool on_receipt(const dds::ChunkReceipt& receipt);
   void acknowledge(const std::string& vehicle, const std::string& run, std::uint64_t through);
+  /// Sets the pending chunk aside with a stand-in when the server's rule refuses it for good.
+  void set_aside_if_refused(const Entry& entry, const std::string& reason);
+  /// Sets the run's chunks aside and throws RunRefused with the server's reason.
+  [[noreturn]] void refuse_run(const std::string& vehicle, const std::string& run,
+                               const std::string& reason);
   void restart_round(const std::string& why);
   /// Stores the held chunks, oldest first, until the spool refuses again.
   void spool_held();
@@ -129,6 +163,10 @@ class Delivery {
   // (vehicle, run) this car announced or spooled: the receipts of the vehicle's other cars (they
   // share its partition) are not its news.
   std::set<std::pair<std::string, std::string>> own_runs_;
+  // (vehicle, run) -> the highest sequence sent (by this process or, for what the spool held at
+  // start, an earlier one): how far an acknowledgement of the run may reach.
+  std::map<std::pair<std::string, std::string>, std::uint64_t> sent_through_;
+  std::vector<std::string> set_aside_;
   DeliveryStats stats_;
 };
 

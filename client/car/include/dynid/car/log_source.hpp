@@ -1,7 +1,7 @@
 #pragma once
 // LogSource: a FrameSource over recorded CAN logs of any format can::open_log() reads (candump
-// -l, Vector ASC, Vector BLF, ASAM MDF4: can/log_reader.hpp picks it from each file's content),
-// the replay path of dynid-car --replay.
+// -l, Vector ASC, Vector BLF, PCAN trace, ASAM MDF4: can/log_reader.hpp picks it from each file's
+// content), the replay path of dynid-car --replay.
 //
 // Several files (the splits of one recording a logger writes, or logs of several buses) are one
 // source: their frames are merged in time order, each file read as it goes (a file's frames

@@ -55,6 +55,11 @@ ReplayProgress replay(FrameSource& source, CarPipeline& pipeline, const ReplayOp
 /// frames (a file of another format, or corrupted).
 std::string replay_problem(const ReplayProgress& counts);
 
+/// True when most of what the source read is no frame (no frame at all, or more bad lines than
+/// frames): the verdicts of replay_problem() after which the file is described by what it looks
+/// like (can/log_content.hpp), since it is likely no log of a format read here.
+bool mostly_not_frames(const ReplayProgress& counts);
+
 /// The counts of the source's first `lines` lines (frames + bad input) as a replay with
 /// `profile` would count them, nothing cut or sent: replay_problem() of a probe refuses a file
 /// that is not a usable log before anything of it is announced, spooled or written.

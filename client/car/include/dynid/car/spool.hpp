@@ -35,6 +35,13 @@
 //   order of their oldest chunk. An acknowledgement that leaves a run without chunks deletes its
 //   announcement too: the server acknowledged the run, so it holds the announcement. Not
 //   counted in bytes(): one small row per run.
+// - Refused chunks: set_aside() keeps a chunk the server refuses for good (its content breaks
+//   the server's rule) in a table of refused chunks with the reason, and puts a stand-in (the
+//   same sequence and rows, every row invalid: delivery.hpp) in its place, so the run's later
+//   chunks are not held up. set_aside_run() moves every chunk of a run the server cannot take
+//   (its name holds another recording's chunks there) to that table and deletes the run's
+//   announcement: nothing of it is resent at the next start, and nothing is lost. refused()
+//   lists them; they are never deleted by the product and not counted in bytes().
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -68,6 +75,13 @@ struct SpoolEntry {
   std::uint64_t bytes = 0;
 };
 
+struct RefusedEntry {
+  std::string vehicle;
+  std::string run;
+  std::uint64_t sequence = 0;
+  std::string reason;
+};
+
 class Spool {
  public:
   /// Opens (creating the directory and database if needed) the spool in `directory`.
@@ -86,6 +100,20 @@ class Spool {
   std::optional<ingest::Chunk> load(const std::string& vehicle, const std::string& run,
                                     std::uint64_t sequence) const;
 
+  /// The stored announcement of a run, if any.
+  std::optional<ingest::RunAnnouncement> announcement(const std::string& vehicle,
+                                                      const std::string& run) const;
+
+  /// Moves the chunk of stand_in's run and sequence to the refused chunks with `reason` and
+  /// stores `stand_in` in its place; InputError when no such chunk is in the spool.
+  void set_aside(const ingest::Chunk& stand_in, const std::string& reason);
+  /// Moves every chunk of the run to the refused chunks with `reason` and deletes its
+  /// announcement; returns how many chunks moved.
+  std::size_t set_aside_run(const std::string& vehicle, const std::string& run,
+                            const std::string& reason);
+  /// The refused chunks, oldest refusal first.
+  std::vector<RefusedEntry> refused() const;
+
   /// The unacknowledged chunks, oldest first (decoded and CRC-checked).
   std::vector<ingest::Chunk> pending() const;
   /// The same, without reading the chunk bytes.
@@ -100,6 +128,7 @@ class Spool {
 
  private:
   void exec(const char* sql) const;
+  void recount();
   std::string full_message(std::uint64_t incoming) const;
 
   std::filesystem::path file_;
