@@ -105,9 +105,9 @@ ResidualReply not_identified_reply(const std::string& title, const std::string& 
                 ",\"not_identified\":" + report::json_string(reason) + "}",
             "application/json"};
   if (format == "html")
-    return {"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>" + report::html_escape(title) +
-                "</title></head><body><p>" + report::html_escape(title + ": " + line) +
-                "</p></body></html>\n",
+    return {"<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>" +
+                report::html_escape(title) + "</title></head><body><p>" +
+                report::html_escape(title + ": " + line) + "</p></body></html>\n",
             "text/html"};
   return {title + ": " + line + "\n", "text/plain"};
 }
