@@ -15,7 +15,7 @@ using detail::trim;
 using detail::words;
 
 constexpr std::int64_t kNsPerDay = 86'400'000'000'000LL;
-constexpr std::int64_t kDaysTo1970 = 25569;       // 1899-12-30 to 1970-01-01
+constexpr std::int64_t kDaysTo1970 = 25569;  // 1899-12-30 to 1970-01-01
 // 1899-12-30 to 2200-01-01: start + offset in nanoseconds stays within int64 (to 2262).
 constexpr std::int64_t kDaysTo2200 = 109'575;
 constexpr std::string_view kColumnLetters = "NOTBIdRlLD";
