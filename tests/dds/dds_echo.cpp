@@ -23,6 +23,11 @@ int main(int argc, char** argv) {
     Reader<dynid_wire_Chunk> in(participant, {vehicle_partition("echo-in")});
     Writer<dynid_wire_Chunk> out(participant, {vehicle_partition("echo-out")});
     Writer<dynid_wire_ChunkAck> acks(participant, {vehicle_partition("echo-in")});
+    // Discovery is asymmetric: the test may see our writers before they see its readers, and a
+    // volatile writer drops what it writes before a reader matches (seen under ASan's slowness).
+    if (!out.wait_for_readers(1, std::chrono::seconds(10)) ||
+        !acks.wait_for_readers(1, std::chrono::seconds(10)))
+      return 2;
     for (std::size_t done = 0; done < count;) {
       auto samples = in.wait_take(std::chrono::seconds(10));
       if (samples.empty()) return 2;
