@@ -261,6 +261,7 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
   residual::DiagnosisOptions options;
   options.declared_noise = announcement.preprocessing.channel_noise;  // the profile's
   std::optional<std::vector<residual::ChannelNoise>> noise;  // measured once, when a model needs it
+  residual::FloorCache floors(run, segments);  // the models' diagnoses share noise and draws
   const ingest::RunHealth health = ingest::channel_health(run);
   for (const ingest::ModelSpec& spec : announcement.models) {
     if (std::find(models.begin(), models.end(), spec.model) == models.end()) continue;
@@ -276,7 +277,7 @@ std::map<std::string, LiveVerdict> live_verdicts(const ingest::RunAnnouncement& 
     try {
       if (diagnose) {
         const residual::Diagnosis d =
-            residual::diagnose(*model, spec.effects, run, segments, options);
+            residual::diagnose(*model, spec.effects, run, segments, options, floors);
         const bool measured = std::all_of(
             d.floor.groups.begin(), d.floor.groups.end(),
             [](const residual::GroupFloor& g) { return g.rows == 0 || g.floor_rms > 0.0; });

@@ -8,7 +8,8 @@
 
 namespace dynid::ls {
 
-EquationGroups::EquationGroups(Eigen::Index parameter_count, std::vector<std::string> names)
+EquationGroups::EquationGroups(Eigen::Index parameter_count, std::vector<std::string> names,
+                               Precision precision)
     : names_(std::move(names)) {
   if (names_.empty()) throw InputError("equation groups: at least one group is needed");
   std::set<std::string> seen;
@@ -17,7 +18,7 @@ EquationGroups::EquationGroups(Eigen::Index parameter_count, std::vector<std::st
     if (!seen.insert(name).second)
       throw InputError("equation groups: duplicate group '" + name + "'");
   }
-  groups_.assign(names_.size(), Accumulator(parameter_count));
+  groups_.assign(names_.size(), Accumulator(parameter_count, precision));
 }
 
 std::size_t EquationGroups::index_of(const std::string& name) const {

@@ -46,7 +46,25 @@ void ChannelSet::replace(const std::string& name, Eigen::VectorXd values) {
   }
 }
 
+namespace {
+thread_local ChannelLookupProbe* active_lookup_probe = nullptr;
+}  // namespace
+
+ChannelLookupProbe::ChannelLookupProbe() : outer_(active_lookup_probe) {
+  active_lookup_probe = this;
+}
+
+ChannelLookupProbe::~ChannelLookupProbe() {
+  active_lookup_probe = outer_;
+}
+
+void ChannelLookupProbe::record(const std::string& name) {
+  looked_up_.insert(name);
+  if (outer_ != nullptr) outer_->record(name);
+}
+
 const Eigen::VectorXd& ChannelSet::operator[](const std::string& name) const {
+  if (active_lookup_probe != nullptr) active_lookup_probe->record(name);
   const auto it = channels_.find(name);
   if (it == channels_.end()) throw InputError("channel set: no channel '" + name + "'");
   return *it->second.values;

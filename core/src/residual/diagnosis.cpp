@@ -277,6 +277,7 @@ struct FloorInputs {
   const std::vector<ingest::PreprocessedSegment>& segments;
   const std::vector<ChannelNoise>& noise;
   const NoiseFloorOptions& options;
+  FloorCache& cache;
 };
 
 // What a significant candidate's own model says: whether it leaves the residual under the
@@ -299,7 +300,7 @@ OwnFloor own_floor(const CandidateScore& c, const FloorInputs& in, const NoiseFl
   effects.push_back(c.effect);
   NoiseFloor floor;
   try {
-    floor = noise_floor(in.model, effects, in.run, in.segments, in.noise, in.options);
+    floor = noise_floor(in.model, effects, in.run, in.segments, in.noise, in.options, in.cache);
   } catch (const InputError&) {
     // The extended model's floor cannot be computed: judged as the declared floor's missing
     // effect, one that explains the whole residual.
@@ -590,6 +591,14 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
 Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
                    const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
                    const DiagnosisOptions& options) {
+  FloorCache cache(run, segments);
+  return diagnose(model, declared, run, segments, options, cache);
+}
+
+Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
+                   const ingest::RecordedRun& run,
+                   const std::vector<ingest::PreprocessedSegment>& segments,
+                   const DiagnosisOptions& options, FloorCache& cache) {
   if (segments.empty()) throw InputError("residual analysis of " + model.name() + ": the run has no valid segment");
   const double rate = run.announcement.sample_rate_hz;
   const int odmf = run.announcement.preprocessing.odmf;
@@ -603,9 +612,9 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
   }
   NoiseFloorOptions floor_options = options.floor;
   floor_options.fit = options.screen.fit;
-  const std::vector<ChannelNoise> noise = measure_channel_noise(run, segments, options.declared_noise);
-  d.floor = noise_floor(model, declared, run, segments, noise, floor_options);
-  const FloorInputs floor_inputs{model, declared, run, segments, noise, floor_options};
+  const std::vector<ChannelNoise>& noise = cache.channel_noise(options.declared_noise);
+  d.floor = noise_floor(model, declared, run, segments, noise, floor_options, cache);
+  const FloorInputs floor_inputs{model, declared, run, segments, noise, floor_options, cache};
   if (d.floor.adequate()) {
     // Structure hidden under the declared signals' noise (diagnosis.hpp): the candidate the loop
     // would accept, when its model stays above its own floor.

@@ -220,7 +220,7 @@ FoldedRows build_rows(const model::Model& model, const std::vector<std::string>&
                                          sample_rate_hz;
   const std::size_t group_count = out.groups.size();
   out.folds.assign(static_cast<std::size_t>(options.cross_validation.folds),
-                   ls::EquationGroups(width, out.groups));
+                   ls::EquationGroups(width, out.groups, options.precision));
   if (collect) {
     out.collected.time_s.resize(group_count);
     out.collected.grid_index.resize(group_count);

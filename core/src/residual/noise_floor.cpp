@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <numbers>
 #include <limits>
+#include <numbers>
 #include <random>
+#include <set>
 
 #include <Eigen/QR>
 #include <boost/math/distributions/normal.hpp>
@@ -172,13 +173,19 @@ struct LagSums {
   std::vector<double> lagged = std::vector<double>(kMaxLags + 1, 0.0);
   long rows = 0;
   void add(const std::vector<std::pair<Eigen::Index, double>>& d, int odmf) {
+    // The lag of each grid distance up to the last one counted, looked up rather than divided:
+    // this loop runs kMaxLags times per row of every draw.
+    const Eigen::Index reach = static_cast<Eigen::Index>(kMaxLags + 1) * odmf;
+    std::vector<std::size_t> lag_of(static_cast<std::size_t>(reach));
+    for (Eigen::Index gap = 0; gap < reach; ++gap)
+      lag_of[static_cast<std::size_t>(gap)] = static_cast<std::size_t>(gap / odmf);
     for (std::size_t i = 0; i < d.size(); ++i) {
       square += d[i].second * d[i].second;
       ++rows;
       for (std::size_t j = i; j-- > 0;) {
-        const Eigen::Index lag = (d[i].first - d[j].first) / odmf;
-        if (lag > kMaxLags) break;
-        lagged[static_cast<std::size_t>(lag)] += d[i].second * d[j].second;
+        const Eigen::Index gap = d[i].first - d[j].first;
+        if (gap >= reach) break;
+        lagged[lag_of[static_cast<std::size_t>(gap)]] += d[i].second * d[j].second;
       }
     }
   }
@@ -214,9 +221,19 @@ struct ScaleSums {
   std::vector<std::vector<LagSums>> share;  // [channel][group]
 };
 
-// Channel `column` of the run with fresh noise of `sigma`.
+// Channel `column` of the run with draw `draw`'s noise of `sigma`. Each draw has its own
+// generator, seeded by (seed, channel, draw): a draw is the same whichever floor asks for it and
+// whatever channels that floor's model reads, so that draws can be shared (FloorCache) and a
+// floor does not depend on how the question was asked.
 Eigen::VectorXd with_noise(const ingest::RecordedRun& run, Eigen::Index column, double sigma,
-                           std::mt19937_64& rng) {
+                           int draw, std::uint64_t seed) {
+  const std::string& channel = run.announcement.channels.at(static_cast<std::size_t>(column)).name;
+  std::vector<std::uint32_t> key{static_cast<std::uint32_t>(seed),
+                                 static_cast<std::uint32_t>(seed >> 32),
+                                 static_cast<std::uint32_t>(draw)};
+  key.insert(key.end(), channel.begin(), channel.end());
+  std::seed_seq sequence(key.begin(), key.end());
+  std::mt19937_64 rng(sequence);
   Eigen::VectorXd noisy = run.samples.col(column);
   std::normal_distribution<double> normal(0.0, 1.0);
   for (Eigen::Index i = 0; i < noisy.size(); ++i) noisy(i) += sigma * normal(rng);
@@ -389,46 +406,100 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
   return noise_floor(model, effects, run, ingest::preprocess_offline(run), noise, options);
 }
 
+FloorCache::FloorCache(const ingest::RecordedRun& run,
+                       const std::vector<ingest::PreprocessedSegment>& segments)
+    : run_(run), segments_(segments) {}
+
+const std::vector<ingest::PreprocessedSegment>& FloorCache::noisy(Eigen::Index column, double sigma,
+                                                                  int draw, std::uint64_t seed) {
+  const auto key = std::make_tuple(column, sigma, draw, seed);
+  auto it = draws_.find(key);
+  if (it == draws_.end())
+    it =
+        draws_
+            .emplace(key, ingest::preprocess_channel_again(
+                              run_, segments_, column, with_noise(run_, column, sigma, draw, seed)))
+            .first;
+  return it->second;
+}
+
+const std::vector<ChannelNoise>& FloorCache::channel_noise(
+    const std::map<std::string, double>& declared) {
+  auto it = noise_.find(declared);
+  if (it == noise_.end())
+    it = noise_.emplace(declared, measure_channel_noise(run_, segments_, declared)).first;
+  return it->second;
+}
+
+const NoiseFloor* FloorCache::floor(const std::string& model,
+                                    const std::vector<std::string>& effects) const {
+  const auto it = floors_.find({model, effects});
+  return it == floors_.end() ? nullptr : &it->second;
+}
+
+void FloorCache::keep(const std::string& model, const std::vector<std::string>& effects,
+                      const NoiseFloor& floor) {
+  floors_.insert_or_assign({model, effects}, floor);
+}
+
 NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>& effects,
                        const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
                        const std::vector<ChannelNoise>& noise, const NoiseFloorOptions& options) {
+  FloorCache cache(run, segments);
+  return noise_floor(model, effects, run, segments, noise, options, cache);
+}
+
+NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>& effects,
+                       const ingest::RecordedRun& run,
+                       const std::vector<ingest::PreprocessedSegment>& segments,
+                       const std::vector<ChannelNoise>& noise, const NoiseFloorOptions& options,
+                       FloorCache& cache) {
+  if (const NoiseFloor* known = cache.floor(model.name(), effects)) return *known;
   if (options.draws < 1) throw InputError("noise floor: draws " + std::to_string(options.draws) + " < 1");
   if (segments.empty()) throw InputError("noise floor of " + model.name() + ": the run has no valid segment");
   const double rate = run.announcement.sample_rate_hz;
   const int odmf = run.announcement.preprocessing.odmf;
   FitOptions fit_options = options.fit;
   fit_options.series = false;
-  const detail::FoldedRows base = detail::fold_rows(model, effects, segments, rate, odmf, fit_options, true);
+  // Double precision: a share is the difference of two fits of one model, noise of the sensors'
+  // size apart, far above double rounding; every fit of the floor (the base too, so that a draw
+  // that changes no row leaves a share of exactly 0) folds with LAPACK's blocked kernel.
+  fit_options.precision = ls::Precision::kDouble;
+  // The channels the rows look up: any other cannot be read (ChannelLookupProbe), so only these
+  // are put to reads_channel's test, which builds the rows again for each.
+  std::set<std::string> looked_up;
+  const detail::FoldedRows base = [&] {
+    model::ChannelLookupProbe lookups;
+    detail::FoldedRows rows =
+        detail::fold_rows(model, effects, segments, rate, odmf, fit_options, true);
+    looked_up = lookups.looked_up();
+    return rows;
+  }();
   const Eigen::VectorXd x = detail::solution(base);
   const detail::GridResiduals r0 = detail::residuals_at(base, x);
   const detail::RowSelection rows = detail::kept_rows(model, effects, segments, rate, odmf);
   // One channel at a time: the floor is the sum of the channels' shares, and each share's
   // uncertainty (its sigma's, measured) is carried on its own. A channel the rows do not read
-  // (most of a car's) gets no draw: its noise would leave the residual exactly unchanged. Its
-  // first draw is still taken from the generator, so that the other channels' draws, and the
-  // floor, do not depend on how the question was asked. A channel the rows read whose noise
-  // leaves the residual unchanged all the same gets one draw.
+  // (most of a car's) gets no draw: its noise would leave the residual exactly unchanged. A
+  // channel the rows read whose noise leaves the residual unchanged all the same gets one draw.
   std::vector<std::vector<LagSums>> shares;  // [channel][group]
   std::vector<ScaleSums> scale_shares(kBlockRows.size());
   std::vector<double> share_relative_variance;
   std::vector<std::string> contributing;
-  std::mt19937_64 rng(options.seed);
   for (const ChannelNoise& c : noise) {
     const Eigen::Index column = column_of(run.announcement, c.channel);
     if (column < 0 || !(c.sigma > 0.0)) continue;
     const std::string derivative =
         column_of(run.announcement, "d_" + c.channel) < 0 ? "d_" + c.channel : "";
-    if (!detail::reads_channel(base, model, effects, segments, rate, odmf, fit_options, c.channel,
-                               derivative, c.sigma)) {
-      with_noise(run, column, c.sigma, rng);
+    const bool seen = looked_up.count(c.channel) > 0 || looked_up.count("d_" + c.channel) > 0;
+    if (!seen || !detail::reads_channel(base, model, effects, segments, rate, odmf, fit_options,
+                                        c.channel, derivative, c.sigma))
       continue;
-    }
     std::vector<LagSums> sums(r0.size());
     std::vector<std::vector<LagSums>> blocks(kBlockRows.size(), std::vector<LagSums>(r0.size()));
     for (int d = 0; d < options.draws; ++d) {
       cancellation_point();
-      const auto noisy = ingest::preprocess_channel_again(run, segments, column,
-                                                          with_noise(run, column, c.sigma, rng));
+      const auto& noisy = cache.noisy(column, c.sigma, d, options.seed);
       // Refitted: the draw's own least squares, so that the attenuation its noise causes in the
       // parameters of a noisy regressor (errors in variables, slow like the signals) is in the
       // share, as the run's own noise put it into the run's residual (header, 2.).
@@ -456,6 +527,7 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
   for (std::size_t g = 0; g < r0.size(); ++g)
     out.groups.push_back(group_floor(base.groups[g], r0[g], shares, scale_shares, g, share_relative_variance,
                                      odmf, rate, options, tested));
+  cache.keep(model.name(), effects, out);
   return out;
 }
 

@@ -112,9 +112,11 @@ Trace trace(const model::Model& model, const std::vector<std::string>& declared,
   t.model = model.name();
   t.declared = declared;
   std::vector<std::string> effects = declared;
+  FloorCache cache(run, segments);
   for (int round = 0;; ++round) {
     cancellation_point();
-    TraceRound r{effects, diagnose(model, effects, run, segments, options.diagnosis), std::nullopt};
+    TraceRound r{effects, diagnose(model, effects, run, segments, options.diagnosis, cache),
+                 std::nullopt};
     const Verdict verdict = r.diagnosis.verdict;
     // A partial explanation is added like a full one (what it leaves may be a second effect),
     // unless it moves the declared physics (partial_refusal).

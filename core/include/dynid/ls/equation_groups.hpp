@@ -38,8 +38,10 @@ struct WeightedEstimate {
 
 class EquationGroups {
  public:
-  /// Named groups over `parameter_count` parameters; names must be unique and non-empty.
-  EquationGroups(Eigen::Index parameter_count, std::vector<std::string> names);
+  /// Named groups over `parameter_count` parameters; names must be unique and non-empty. Each
+  /// group's accumulator folds in `precision` (accumulator.hpp).
+  EquationGroups(Eigen::Index parameter_count, std::vector<std::string> names,
+                 Precision precision = Precision::kExtended);
 
   std::size_t size() const { return names_.size(); }
   const std::string& name(std::size_t group) const { return names_.at(group); }

@@ -9,14 +9,35 @@
 // sample marked valid throws InputError naming the channel and sample. A channel's values never
 // change once added (replace swaps in new ones), so copies of a set share them: copying a set, as
 // the residual loop does for every candidate and noise draw, costs its names, not its samples.
+//
+// ChannelLookupProbe lists the channels a computation can have read: while one is alive on a
+// thread, every lookup of a channel's values (operator[]) on that thread is recorded. A channel
+// not in the list was never seen, so the computation's result cannot depend on its values.
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
 namespace dynid::model {
+
+/// Records the channels whose values are looked up on this thread, while alive (above); probes
+/// nest, and a lookup is recorded by every live one.
+class ChannelLookupProbe {
+ public:
+  ChannelLookupProbe();
+  ~ChannelLookupProbe();
+  ChannelLookupProbe(const ChannelLookupProbe&) = delete;
+  ChannelLookupProbe& operator=(const ChannelLookupProbe&) = delete;
+  const std::set<std::string>& looked_up() const { return looked_up_; }
+  void record(const std::string& name);
+
+ private:
+  std::set<std::string> looked_up_;
+  ChannelLookupProbe* outer_;
+};
 
 class ChannelSet {
  public:

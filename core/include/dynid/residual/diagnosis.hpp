@@ -198,5 +198,12 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
 Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
                    const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
                    const DiagnosisOptions& options);
+/// The same through `cache` (made on `run` and `segments`, used with the same options): the
+/// channel noise, the noise draws and the floors of earlier diagnoses of the run are reused (the
+/// trace's rounds: a round's declared floor is the floor of the candidate the round before added).
+Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& declared,
+                   const ingest::RecordedRun& run,
+                   const std::vector<ingest::PreprocessedSegment>& segments,
+                   const DiagnosisOptions& options, FloorCache& cache);
 
 }  // namespace dynid::residual

@@ -70,6 +70,10 @@ struct FitOptions {
   /// Weights of the weighted figures, per group in the model's group order; empty: the fit's
   /// own 1/sigma_j. Give the declared model's weights to compare two fits on one scale.
   std::vector<double> group_weights;
+  /// The folds' arithmetic (ls/accumulator.hpp): extended for the published fits; double where
+  /// the data are far noisier than double rounding and only noise is measured (the noise floor's
+  /// draws).
+  ls::Precision precision = ls::Precision::kExtended;
 };
 
 /// Fits `model` with `effects` (model, dictionary or road-profile effects; at most one road

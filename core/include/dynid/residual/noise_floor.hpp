@@ -24,6 +24,8 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "dynid/ingest/recorded_run.hpp"
@@ -98,6 +100,38 @@ struct NoiseFloor {
   bool adequate() const;
 };
 
+/// What the floors computed on one run share, kept across the floors of one request (the
+/// declared model's, each significant candidate's, round after round of a trace): each channel's
+/// noise draws, preprocessed again, and the floors already computed, by model and effects. A floor
+/// computed through the cache equals one computed without it, bit for bit: every draw's noise
+/// comes from its own generator, seeded by (seed, channel, draw), so it is the same whichever
+/// floor asks for it first. Serves one run with one channel-noise measurement and one set of
+/// NoiseFloorOptions; memory: one preprocessed channel (and its derivative) per draw of each
+/// channel the asked models read. Not thread-safe.
+class FloorCache {
+ public:
+  FloorCache(const ingest::RecordedRun& run,
+             const std::vector<ingest::PreprocessedSegment>& segments);
+  /// `segments` with channel `column` carrying draw `draw`'s noise of `sigma`, preprocessed again.
+  const std::vector<ingest::PreprocessedSegment>& noisy(Eigen::Index column, double sigma, int draw,
+                                                        std::uint64_t seed);
+  /// measure_channel_noise(run, segments, declared), measured once.
+  const std::vector<ChannelNoise>& channel_noise(const std::map<std::string, double>& declared);
+  /// The floor computed before for this model and effects, or nullptr.
+  const NoiseFloor* floor(const std::string& model, const std::vector<std::string>& effects) const;
+  void keep(const std::string& model, const std::vector<std::string>& effects,
+            const NoiseFloor& floor);
+
+ private:
+  const ingest::RecordedRun& run_;
+  const std::vector<ingest::PreprocessedSegment>& segments_;
+  std::map<std::tuple<Eigen::Index, double, int, std::uint64_t>,
+           std::vector<ingest::PreprocessedSegment>>
+      draws_;
+  std::map<std::pair<std::string, std::vector<std::string>>, NoiseFloor> floors_;
+  std::map<std::map<std::string, double>, std::vector<ChannelNoise>> noise_;
+};
+
 /// The floor of `model` with `effects` on `run` (see above). InputError as fit_model.
 NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>& effects,
                        const ingest::RecordedRun& run, const std::vector<ChannelNoise>& noise,
@@ -106,5 +140,12 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
 NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>& effects,
                        const ingest::RecordedRun& run, const std::vector<ingest::PreprocessedSegment>& segments,
                        const std::vector<ChannelNoise>& noise, const NoiseFloorOptions& options);
+/// The same through `cache` (made on `run` and `segments`): a floor asked before is returned as
+/// it was computed, and draws asked before are not drawn and preprocessed again.
+NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>& effects,
+                       const ingest::RecordedRun& run,
+                       const std::vector<ingest::PreprocessedSegment>& segments,
+                       const std::vector<ChannelNoise>& noise, const NoiseFloorOptions& options,
+                       FloorCache& cache);
 
 }  // namespace dynid::residual
