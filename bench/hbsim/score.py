@@ -454,6 +454,25 @@ def channel_noise(reply):
     return {}
 
 
+# The floor test's level over a trace's groups (NoiseFloorOptions::error_rate, noise_floor.hpp):
+# the JSON gives each group's upper_ratio = exp(z * std), z the normal quantile at 1 - this / groups.
+FLOOR_ERROR_RATE = 0.025
+
+
+def floor_statistics(trace):
+    """The first round's floor test per group with rows: z = log(ratio) / its std under "the
+    model lacks nothing" (about N(0, 1) on a clean run if the floor and its std are right)."""
+    if not trace or not trace.get("rounds"):
+        return []
+    groups = [g for g in trace["rounds"][0]["diagnosis"].get("floor", {}).get("groups", []) if g.get("rows")]
+    quantile = statistics.NormalDist().inv_cdf(1.0 - FLOOR_ERROR_RATE / max(len(groups), 1))
+    out = []
+    for g in groups:
+        if g.get("upper_ratio", 0) > 1.0 and g.get("ratio", 0) > 0.0:
+            out.append(math.log(g["ratio"]) * quantile / math.log(g["upper_ratio"]))
+    return out
+
+
 def fmt_pct(v):
     return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:+.2f}"
 
@@ -511,6 +530,7 @@ def main(argv=None):
                     ok, why = rule["rule"](trace, run)
                     row.update(right=ok, why=why, rule=rule["rule"].text, readme=rule["readme"])
                 row["alarm"] = bool(trace.get("added")) or final != "adequate"
+                row["floor_z"] = floor_statistics(trace)
             ref, ref_err = load_json(os.path.join(reply, f"trace-ref-{model}.json"))
             if ref is not None:
                 use = reference_use(ref, os.path.join(reply, f"trace-ref-{model}.args"))
@@ -600,6 +620,15 @@ def main(argv=None):
         ratios = sorted(tr["noise"][ch] / sim for tr in time_rows if ch in tr.get("noise", {}))
         if ratios:
             print(f"{ch:<14} median {statistics.median(ratios):.3f}, range {ratios[0]:.3f}-{ratios[-1]:.3f} over {len(ratios)} runs")
+
+    print("\n== the floor test on clean traces (first round): z = log(ratio of squares) / its std, per model")
+    print("   (about mean 0, std 1 if the floor and its stated uncertainty hold on this car)")
+    by_model = {}
+    for r in clean_rows:
+        by_model.setdefault(r["model"], []).extend(r.get("floor_z", []))
+    for m, zs in by_model.items():
+        if len(zs) >= 2:
+            print(f"{m:<23} mean {statistics.mean(zs):+.2f}, std {statistics.stdev(zs):.2f} over {len(zs)} groups")
 
     print("\n== request times (s)")
     for tr in time_rows:
