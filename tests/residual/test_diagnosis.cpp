@@ -176,6 +176,29 @@ TEST(NoiseFloor, OnlyTheChannelsTheRowsReadGetDraws) {
   EXPECT_EQ(with.groups[0].ratio, without.groups[0].ratio);
 }
 
+// FloorCache (noise_floor.hpp): a draw dropped for the memory budget is drawn again the same, so
+// a floor through a cache that can hold one draw at a time equals the floor through one that holds
+// them all, bit for bit; and the cache holds no more than its budget and the draw just made.
+TEST(NoiseFloor, ACacheOverItsBudgetDrawsAgainTheSameFloor) {
+  const auto model = model::make_model("kinematic_longitudinal", {});
+  const auto run = kinematic_run(3, 0.0);
+  const auto segments = ingest::preprocess_offline(run);
+  const std::vector<ChannelNoise> noise = {{"vx", 0.02, "declared"}, {"ax", 0.05, "declared"}};
+  FloorCache roomy(run, segments);
+  FloorCache tight(run, segments, 1);
+  const NoiseFloor all = noise_floor(*model, {}, run, segments, noise, {}, roomy);
+  const NoiseFloor one = noise_floor(*model, {}, run, segments, noise, {}, tight);
+  ASSERT_EQ(all.groups.size(), 1U);
+  ASSERT_EQ(one.groups.size(), 1U);
+  EXPECT_GT(all.groups[0].floor_rms, 0.0);
+  EXPECT_EQ(one.groups[0].floor_rms, all.groups[0].floor_rms);
+  EXPECT_EQ(one.groups[0].ratio, all.groups[0].ratio);
+  EXPECT_EQ(one.groups[0].effective_rows, all.groups[0].effective_rows);
+  const std::size_t one_draw = 2 * sizeof(double) * static_cast<std::size_t>(run.samples.rows());
+  EXPECT_LE(tight.draw_bytes(), one_draw);
+  EXPECT_GT(roomy.draw_bytes(), one_draw);  // every draw of both channels kept
+}
+
 TEST(NoiseFloor, AModelThatLacksNothingIsAdequateAtTheStatedRate) {
   const auto model = model::make_model("kinematic_longitudinal", {});
   int adequate = 0;

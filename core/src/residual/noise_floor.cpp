@@ -407,20 +407,33 @@ NoiseFloor noise_floor(const model::Model& model, const std::vector<std::string>
 }
 
 FloorCache::FloorCache(const ingest::RecordedRun& run,
-                       const std::vector<ingest::PreprocessedSegment>& segments)
-    : run_(run), segments_(segments) {}
+                       const std::vector<ingest::PreprocessedSegment>& segments,
+                       std::size_t draw_budget_bytes)
+    : run_(run), segments_(segments), draw_budget_(draw_budget_bytes) {}
 
 const std::vector<ingest::PreprocessedSegment>& FloorCache::noisy(Eigen::Index column, double sigma,
                                                                   int draw, std::uint64_t seed) {
-  const auto key = std::make_tuple(column, sigma, draw, seed);
-  auto it = draws_.find(key);
-  if (it == draws_.end())
-    it =
-        draws_
-            .emplace(key, ingest::preprocess_channel_again(
-                              run_, segments_, column, with_noise(run_, column, sigma, draw, seed)))
-            .first;
-  return it->second;
+  const DrawKey key{column, sigma, draw, seed};
+  if (const auto it = draws_.find(key); it != draws_.end()) {
+    uses_.splice(uses_.begin(), uses_, it->second.use);
+    return it->second.segments;
+  }
+  std::vector<ingest::PreprocessedSegment> segments = ingest::preprocess_channel_again(
+      run_, segments_, column, with_noise(run_, column, sigma, draw, seed));
+  // What the draw holds of its own: the channel and its derivative, every other channel shared.
+  std::size_t bytes = 0;
+  for (const ingest::PreprocessedSegment& s : segments)
+    bytes += 2 * sizeof(double) * static_cast<std::size_t>(s.channels.samples());
+  while (!uses_.empty() && draw_bytes_ + bytes > draw_budget_) {
+    const auto oldest = draws_.find(uses_.back());
+    draw_bytes_ -= oldest->second.bytes;
+    draws_.erase(oldest);
+    uses_.pop_back();
+  }
+  uses_.push_front(key);
+  draw_bytes_ += bytes;
+  return draws_.emplace(key, Draw{std::move(segments), bytes, uses_.begin()})
+      .first->second.segments;
 }
 
 const std::vector<ChannelNoise>& FloorCache::channel_noise(

@@ -21,7 +21,9 @@
 //    beside the verdict, not in it.
 // Limits (said in the report): signal content above the cut-off counts as noise; noise that is
 // not flat across the cut-off is misjudged.
+#include <cstddef>
 #include <cstdint>
+#include <list>
 #include <map>
 #include <string>
 #include <tuple>
@@ -106,15 +108,22 @@ struct NoiseFloor {
 /// computed through the cache equals one computed without it, bit for bit: every draw's noise
 /// comes from its own generator, seeded by (seed, channel, draw), so it is the same whichever
 /// floor asks for it first. Serves one run with one channel-noise measurement and one set of
-/// NoiseFloorOptions; memory: one preprocessed channel (and its derivative) per draw of each
-/// channel the asked models read. Not thread-safe.
+/// NoiseFloorOptions. Memory: one preprocessed channel (and its derivative) per draw, at most
+/// `draw_budget_bytes` of them; past it the draws used longest ago are dropped and, when asked
+/// again, drawn again (the same draws: their generators are seeded). Not thread-safe.
 class FloorCache {
  public:
+  /// 256 MiB: four draws of each of 66 channels of a 10-minute run at 100 Hz, of 11 channels of a
+  /// 60-minute one (a draw holds 16 bytes a sample).
+  static constexpr std::size_t kDefaultDrawBudget = std::size_t{256} << 20;
   FloorCache(const ingest::RecordedRun& run,
-             const std::vector<ingest::PreprocessedSegment>& segments);
+             const std::vector<ingest::PreprocessedSegment>& segments,
+             std::size_t draw_budget_bytes = kDefaultDrawBudget);
   /// `segments` with channel `column` carrying draw `draw`'s noise of `sigma`, preprocessed again.
+  /// The reference holds until the next call.
   const std::vector<ingest::PreprocessedSegment>& noisy(Eigen::Index column, double sigma, int draw,
                                                         std::uint64_t seed);
+  std::size_t draw_bytes() const { return draw_bytes_; }
   /// measure_channel_noise(run, segments, declared), measured once.
   const std::vector<ChannelNoise>& channel_noise(const std::map<std::string, double>& declared);
   /// The floor computed before for this model and effects, or nullptr.
@@ -125,9 +134,16 @@ class FloorCache {
  private:
   const ingest::RecordedRun& run_;
   const std::vector<ingest::PreprocessedSegment>& segments_;
-  std::map<std::tuple<Eigen::Index, double, int, std::uint64_t>,
-           std::vector<ingest::PreprocessedSegment>>
-      draws_;
+  using DrawKey = std::tuple<Eigen::Index, double, int, std::uint64_t>;
+  struct Draw {
+    std::vector<ingest::PreprocessedSegment> segments;
+    std::size_t bytes = 0;
+    std::list<DrawKey>::iterator use;  // its place in uses_
+  };
+  std::size_t draw_budget_;
+  std::size_t draw_bytes_ = 0;
+  std::map<DrawKey, Draw> draws_;
+  std::list<DrawKey> uses_;  // most recently used first
   std::map<std::pair<std::string, std::vector<std::string>>, NoiseFloor> floors_;
   std::map<std::map<std::string, double>, std::vector<ChannelNoise>> noise_;
 };
