@@ -9,10 +9,12 @@
 //    (log PSD = a + b f^2) and reported as the white-noise std at the grid rate. A profile may
 //    declare a channel's noise instead (source "declared").
 // 2. noise_floor: each channel's share of the residual, carried through the product's own path:
-//    `draws` copies of the raw run with fresh noise of that channel's sigma, preprocessed as the
-//    server does, rows built and fitted again; the floor is the sum of the shares, with its
-//    autocorrelation (the effective number of rows of a mean square, Bartlett). A channel the
-//    rows do not read (the rows come out the same with it moved) has no share and no draw.
+//    `draws` copies of the raw run with fresh noise of that channel's sigma and a fresh time for
+//    each of its steps within its sample interval (step_timing.hpp: the samples do not hold it),
+//    preprocessed as the server does, rows built and fitted again; the floor is the sum of the
+//    shares, with its autocorrelation (the effective number of rows of a mean square, Bartlett). A
+//    channel the rows do not read (the rows come out the same with it moved) has no share and no
+//    draw.
 // 3. The verdict per equation group: log(residual mean square / floor mean square) against the
 //    normal quantile 1 - error_rate / groups, its variance the residual's (2 / n_eff) plus the
 //    floor's own (measurement bootstrap, draws). A model that lacks nothing is called
