@@ -151,6 +151,7 @@ std::string format_consistency_text(const residual::Consistency& c, const std::v
   if (!c.comparisons.empty())
     out += fmt::format("(* beyond the level {:.2g}: family error rate 1 % over {} comparisons; std are HAC)\n", c.level,
                        c.tests);
+  for (const std::string& n : c.not_compared) out += "not compared: " + n + "\n";
   for (const std::string& l : left_out) out += "left out: " + l + "\n";
   return out + "consistency: " + c.statement() + "\n";
 }
@@ -222,6 +223,7 @@ json diagnosis_object(const residual::Diagnosis& d) {
                       {"floor_rms", finite(g.floor_rms)},
                       {"ratio", finite(g.ratio)},
                       {"upper_ratio", finite(g.upper_ratio)},
+                      {"log_ratio_std", finite(g.log_ratio_std)},
                       {"effective_rows", finite(g.effective_rows)},
                       {"scales", scales_json(g)},
                       {"at_floor", g.at_floor}});
@@ -370,11 +372,9 @@ std::string consistency_json(const residual::Consistency& c, const std::vector<s
                       {"one_ratio", f.one_ratio},
                       {"off", f.off},
                       {"statement", f.statement}});
-  return json{{"consistent", c.consistent()},
-              {"level", finite(c.level)},
-              {"comparisons", comparisons},
-              {"scales", scales},
-              {"left_out", left_out},
+  return json{{"consistent", c.consistent()},   {"level", finite(c.level)},
+              {"comparisons", comparisons},     {"scales", scales},
+              {"not_compared", c.not_compared}, {"left_out", left_out},
               {"statement", c.statement()}}
       .dump();
 }

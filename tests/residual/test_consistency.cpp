@@ -106,6 +106,26 @@ TEST(Consistency, AParameterTheRunDoesNotExciteIsComparedWithNothing) {
   for (const ParameterAgreement& p : c.comparisons) EXPECT_NE(p.parameter, "mass");
 }
 
+// An independent car's launch: the engine-torque model's mass 430 +- 180 kg (42 %), least
+// squares biased by a noisy column far beyond its std. Beyond DYCARO's 10 % it is listed, with
+// its precision, and compared with nothing, neither the other model nor the reference.
+TEST(Consistency, AParameterBeyondTheQualityLimitIsListedNotCompared) {
+  const ModelParameters wheel = fitted("wheel", {"wheel_torque"}, kTruth, 0.004);
+  ModelParameters engine = fitted("engine", {"engine_torque"}, kTruth, 0.004);
+  engine.value(0) = 430.0;
+  engine.std(0) = 180.0;
+  const Consistency c = check_consistency({wheel, engine}, {{"mass", 1500.0}});
+  EXPECT_TRUE(c.consistent()) << c.statement();
+  EXPECT_EQ(c.tests, 3);  // SCx, rolling resistance, the wheel model's mass against the reference
+  ASSERT_EQ(c.not_compared.size(), 1U);
+  EXPECT_EQ(c.not_compared.front(),
+            "engine: mass = 430 +- 1.8e+02 u (42 % relative std, beyond the 10 % of an identified "
+            "value)");
+  // Within the limit it is compared, and the disagreement found.
+  engine.std(0) = 40.0;
+  EXPECT_FALSE(check_consistency({wheel, engine}, {}).consistent());
+}
+
 TEST(Consistency, ModelsDeclareTheQuantitiesTheyShare) {
   const auto quantity_of = [](const std::string& name, const std::string& parameter) {
     // The test car's constants; the engine-torque model (not in its profile) with the

@@ -24,16 +24,24 @@ std::string format(const char* pattern, double a, double b = 0.0, double c = 0.0
   return buf;
 }
 
+// Relative std within DYCARO's quality limit (parameter_status.hpp rule 3's absolute one).
+bool precise(const ModelParameters& m, Eigen::Index i) {
+  return std::abs(m.std(i)) <=
+         model::StatusRules{}.poor_relative_std_percent / 100.0 * std::abs(m.value(i));
+}
+
 std::string join(const std::vector<std::string>& items) {
   std::string out;
   for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
   return out;
 }
 
-// The value and HAC std of parameter j of `m`, when the run identifies it: finite, and excited
-// (parameter_status.hpp rule 1b: a std at least the quantity's typical magnitude says the run
-// cannot tell it from zero, and its value is whatever the other columns leave).
-bool lookup(const ModelParameters& m, std::size_t j, double& value, double& std) {
+// The value and HAC std of parameter j of `m`, when the run excites it: finite, and not
+// parameter_status.hpp rule 1b (a std at least the quantity's typical magnitude says the run
+// cannot tell it from zero, and its value is whatever the other columns leave). lookup: and
+// within DYCARO's quality limit (the header: beyond it least squares' bias is not bounded by the
+// std), which is what is compared.
+bool excited(const ModelParameters& m, std::size_t j, double& value, double& std) {
   const auto i = static_cast<Eigen::Index>(j);
   if (j >= m.parameters.size() || !std::isfinite(m.value(i)) || !std::isfinite(m.std(i)))
     return false;
@@ -43,6 +51,10 @@ bool lookup(const ModelParameters& m, std::size_t j, double& value, double& std)
   value = m.value(i);
   std = m.std(i);
   return true;
+}
+
+bool lookup(const ModelParameters& m, std::size_t j, double& value, double& std) {
+  return excited(m, j, value, std) && precise(m, static_cast<Eigen::Index>(j));
 }
 
 // The index in `m` of the parameter measuring `quantity` in `unit`, or npos.
@@ -232,6 +244,10 @@ bool Consistency::consistent() const {
 }
 
 std::string Consistency::statement() const {
+  if (comparisons.empty() && !not_compared.empty())
+    return "nothing compared: the parameters two models share, or that have a reference value, are "
+           "not precise "
+           "enough on this run (not compared)";
   if (comparisons.empty()) return "no parameter to compare: no two models share one, and no reference value applies";
   if (consistent())
     return "consistent: " + std::to_string(comparisons.size()) +
@@ -242,10 +258,40 @@ std::string Consistency::statement() const {
   return out;
 }
 
+namespace {
+
+// The parameters comparisons_of would have compared (a quantity another model measures, or a
+// reference value) but left out for their precision alone.
+std::vector<std::string> imprecise_of(const std::vector<ModelParameters>& models,
+                                      const std::map<std::string, double>& reference) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    const ModelParameters& m = models[i];
+    for (std::size_t j = 0; j < m.parameters.size(); ++j) {
+      const model::ParameterInfo& p = m.parameters[j];
+      bool shared = reference.count(p.reference_key()) > 0;
+      for (std::size_t k = 0; k < models.size() && !shared && !p.quantity.empty(); ++k)
+        shared = k != i && measuring(models[k], p.quantity, p.unit) != std::string::npos;
+      double value = 0.0, std = 0.0;
+      if (!shared || !excited(m, j, value, std) || precise(m, static_cast<Eigen::Index>(j)))
+        continue;
+      out.push_back(m.model + ": " + p.name + " = " + format("%.4g", value) + " +- " +
+                    format("%.2g", std) + " " + p.unit + " (" +
+                    format("%.0f", 100.0 * std / std::abs(value)) + " % relative std, beyond the " +
+                    format("%.0f", model::StatusRules{}.poor_relative_std_percent) +
+                    " % of an identified value)");
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 Consistency check_consistency(const std::vector<ModelParameters>& models,
                               const std::map<std::string, double>& reference, double family_error_rate) {
   Consistency out;
   out.comparisons = comparisons_of(models, reference);
+  out.not_compared = imprecise_of(models, reference);
   out.tests = static_cast<int>(out.comparisons.size());
   out.level = out.tests > 0 ? family_error_rate / out.tests : 0.0;
   for (ParameterAgreement& c : out.comparisons) c.significant = c.p_value < out.level;
