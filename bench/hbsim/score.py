@@ -441,6 +441,17 @@ SIMULATED_NOISE = {
     "steer": 0.05 * math.pi / 180.0 / 15.5,      # EpsSwAngle 0.05 deg at the hand wheel
     "wheel_torque": 2.0 * math.sqrt(2.0),        # WtmTrqRL + WtmTrqRR, 2 N m each
 }
+# Messages at 50 Hz, interpolated onto the 100 Hz grid: the white noise at the grid rate with the
+# same in-band level is sigma x sqrt(100 / 50) (the level below the cut-off is the message's,
+# sigma^2 / 50 per Hz one-sided x 2; the interpolation's fall within the 5 Hz band is 2 %).
+SIMULATED_NOISE_50HZ = {
+    "vx": 0.02 / 2.0 * math.sqrt(2.0),                             # mean of 4 wheels, 0.02 m/s each
+    "wheel_speed_fl": 0.02 * math.sqrt(2.0),
+    "engine_speed": 1.5 * 2.0 * math.pi / 60.0 * math.sqrt(2.0),   # EmsEngRpm 1.5 rpm
+    "engine_torque": 1.5 * math.sqrt(2.0),                          # EmsTrqAct 1.5 N m
+    "gearbox_input_speed": 2.0 * 2.0 * math.pi / 60.0 * math.sqrt(2.0),  # TcuInRpm 2 rpm
+    "clutch_clamp_load": 25.0 * math.sqrt(2.0),                    # TcuClutchLoad 25 N
+}
 
 
 def channel_noise(reply):
@@ -455,7 +466,8 @@ def channel_noise(reply):
 
 
 # The floor test's level over a trace's groups (NoiseFloorOptions::error_rate, noise_floor.hpp):
-# the JSON gives each group's upper_ratio = exp(z * std), z the normal quantile at 1 - this / groups.
+# the JSON gives each group's log_ratio_std, and upper_ratio = exp(z * std), z the normal quantile
+# at 1 - this / groups (older replies carry only the latter).
 FLOOR_ERROR_RATE = 0.025
 
 
@@ -468,7 +480,9 @@ def floor_statistics(trace):
     quantile = statistics.NormalDist().inv_cdf(1.0 - FLOOR_ERROR_RATE / max(len(groups), 1))
     out = []
     for g in groups:
-        if g.get("upper_ratio", 0) > 1.0 and g.get("ratio", 0) > 0.0:
+        if g.get("log_ratio_std", 0) > 0.0 and g.get("ratio", 0) > 0.0:
+            out.append(math.log(g["ratio"]) / g["log_ratio_std"])
+        elif g.get("upper_ratio", 0) > 1.0 and g.get("ratio", 0) > 0.0:  # replies without the std
             out.append(math.log(g["ratio"]) * quantile / math.log(g["upper_ratio"]))
     return out
 
@@ -615,11 +629,14 @@ def main(argv=None):
             print(f"{u['run']:<30} {u['model']:<23} {secs:>8}  shown {','.join(u['shown']) or '-'}; {note}"
                   f"{'' if u['same_added'] else '; ADDED DIFFERS from the plain trace'}")
 
-    print("\n== channel noise: the floor's measured sigma / the simulated one (100 Hz channels), over runs")
-    for ch, sim in SIMULATED_NOISE.items():
-        ratios = sorted(tr["noise"][ch] / sim for tr in time_rows if ch in tr.get("noise", {}))
-        if ratios:
-            print(f"{ch:<14} median {statistics.median(ratios):.3f}, range {ratios[0]:.3f}-{ratios[-1]:.3f} over {len(ratios)} runs")
+    print("\n== channel noise: the floor's measured sigma / the simulated one, over runs")
+    for label, table in (("100 Hz", SIMULATED_NOISE), ("50 Hz, as white noise at 100 Hz", SIMULATED_NOISE_50HZ)):
+        print(f"   {label}")
+        for ch, sim in table.items():
+            ratios = sorted(tr["noise"][ch] / sim for tr in time_rows if ch in tr.get("noise", {}))
+            if ratios:
+                print(f"{ch:<20} median {statistics.median(ratios):.3f}, range {ratios[0]:.3f}-{ratios[-1]:.3f} "
+                      f"over {len(ratios)} runs")
 
     print("\n== the floor test on clean traces (first round): z = log(ratio of squares) / its std, per model")
     print("   (about mean 0, std 1 if the floor and its stated uncertainty hold on this car)")
