@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <dynid/residual/step_timing.hpp>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -79,6 +80,19 @@ TEST(StepTiming, OnlyValidSamplesAreLookedAt) {
   EXPECT_TRUE(find_steps(x, valid, kSigma).empty());
   EXPECT_TRUE(find_steps(x, all_valid(399), kSigma).empty());  // flags that do not fit: nothing
   EXPECT_TRUE(find_steps(x, all_valid(400), 0.0).empty());     // no noise measured: nothing
+}
+
+TEST(StepTiming, ValuesAtTheEndsOfTheDoubleRangeMakeNoStepWithoutASize) {
+  // Increments that overflow: whatever is found has a finite size and span (a draw stays finite).
+  Eigen::VectorXd x = noisy_line(400, 7);
+  x(200) = std::numeric_limits<double>::max();
+  x(201) = -std::numeric_limits<double>::max();
+  for (const SampledStep& s : find_steps(x, all_valid(400), kSigma)) {
+    EXPECT_TRUE(std::isfinite(s.size));
+    EXPECT_TRUE(std::isfinite(s.span));
+    EXPECT_TRUE(std::isfinite(s.centre));
+  }
+  EXPECT_TRUE(find_steps(Eigen::VectorXd::Constant(400, 3.0), all_valid(400), kSigma).empty());
 }
 
 TEST(StepTiming, ADrawIsAnImpulseOfTheStepTimesAUniformTimeInItsSpan) {

@@ -88,7 +88,9 @@ std::vector<SampledStep> find_steps(const Eigen::VectorXd& x,
     if (i < end && looked_at(valid, i)) departure = increment(x, i) - slope_outside(x, i, i);
     const bool flagged = std::abs(departure) > bound;
     if (first >= 0 && !flagged) {
-      out.push_back(step_of(x, first, i - 1));  // looked_at(i - 1): its outside exists
+      const SampledStep step = step_of(x, first, i - 1);  // looked_at(i - 1): its outside exists
+      if (std::isfinite(step.span))
+        out.push_back(step);  // no part left above the outside slope: none
       first = -1;
     }
     if (flagged && first < 0) first = i;
