@@ -246,8 +246,7 @@ bool Consistency::consistent() const {
 std::string Consistency::statement() const {
   if (comparisons.empty() && !not_compared.empty())
     return "nothing compared: the parameters two models share, or that have a reference value, are "
-           "not precise "
-           "enough on this run (not compared)";
+           "not precise enough on this run (not compared)";
   if (comparisons.empty()) return "no parameter to compare: no two models share one, and no reference value applies";
   if (consistent())
     return "consistent: " + std::to_string(comparisons.size()) +

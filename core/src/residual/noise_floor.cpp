@@ -40,12 +40,6 @@ bool filtered(const ingest::RunAnnouncement& a, const std::string& channel) {
   return std::find(pass.begin(), pass.end(), channel) == pass.end();
 }
 
-// One-sided PSD of x at the bins of [low, high] Hz: Hann windows of `window` samples, half
-// overlapping; the DFT is evaluated at the band's bins only. Keeps every window's periodogram
-// value per bin so that segments pool and the median can be taken: the median over windows
-// (Welch's mean made robust, divided by ln 2, the median of an exponential variable over its
-// mean) ignores the few windows that hold a transient (a gear shift rings the driveline above
-// the cut-off for a second), which are signal, not noise.
 Eigen::VectorXd hann_window(Eigen::Index n) {
   Eigen::VectorXd window(n);
   for (Eigen::Index i = 0; i < n; ++i)
@@ -54,6 +48,12 @@ Eigen::VectorXd hann_window(Eigen::Index n) {
   return window;
 }
 
+// One-sided PSD of x at the bins of [low, high] Hz: Hann windows of `window` samples, half
+// overlapping; the DFT is evaluated at the band's bins only. Keeps every window's periodogram
+// value per bin so that segments pool and the median can be taken: the median over windows
+// (Welch's mean made robust, divided by ln 2, the median of an exponential variable over its
+// mean) ignores the few windows that hold a transient (a gear shift rings the driveline above
+// the cut-off for a second), which are signal, not noise.
 struct BandPsd {
   Eigen::Index window = kMinWindow;
   std::vector<double> frequency;
