@@ -19,8 +19,8 @@
 // noise in it, and least squares' errors-in-variables attenuation, the share of a noisy
 // column's variance that is noise, is then not bounded by the std, while the bias test has too
 // little signal to reject least squares (on an independent car's launches the engine-torque
-// model's mass read 430-1330 kg at 10-42 % relative std, 3-5.5 std from the wheel-torque
-// model's 1450 kg, on every other clean launch). The test of one comparison:
+// model's mass read 430-977 kg at 13-42 % relative std, 3-5.5 std from the wheel-torque
+// model's 1450 kg on 5 of 10 clean launches). The test of one comparison:
 // z = (a - b) / sqrt(sa^2 + sb^2) (a reference has no std), two-sided, at family_error_rate / m
 // (Bonferroni over the m comparisons, so that a run whose models agree raises an alarm at most that
 // often). Ignoring the correlation of two fits of one run is conservative: they share the run's
