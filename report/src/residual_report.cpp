@@ -178,6 +178,21 @@ using nlohmann::json;
 
 using detail::finite;
 
+json sensor_agreement_json(const residual::SensorAgreement& a, bool reaches) {
+  json compared = json::array();
+  for (const residual::ComparedParameter& c : a.compared)
+    compared.push_back({{"name", c.name},
+                        {"unit", c.unit},
+                        {"published", finite(c.published)},
+                        {"published_std", finite(c.published_std)},
+                        {"with_sensor", finite(c.with_sensor)},
+                        {"with_sensor_std", finite(c.with_sensor_std)},
+                        {"moved", finite(c.moved)}});
+  return {{"effect", a.effect},   {"offsets", a.offsets},           {"estimator", a.estimator},
+          {"compared", compared}, {"not_compared", a.not_compared}, {"bound", finite(a.bound)},
+          {"agrees", a.agrees()}, {"reaches_its_floor", reaches},   {"statement", a.statement()}};
+}
+
 json candidate_json(const residual::CandidateScore& c) {
   return {{"effect", c.effect},
           {"kind", residual::kind_name(c.kind)},
@@ -274,6 +289,9 @@ json diagnosis_object(const residual::Diagnosis& d) {
                                   {"resolution", finite(d.hidden->resolution)},
                                   {"statement", d.hidden->statement()}})
                           : json(nullptr)},
+      // A better sensor refused because it agrees with the published parameters.
+      {"sensor_error",
+       d.sensor_error ? sensor_agreement_json(*d.sensor_error, d.sensor_reaches) : json(nullptr)},
       {"floor", {{"groups", groups}, {"channels", noise}, {"contributing", d.floor.contributing}}},
       {"candidate_level", finite(d.screen.level)},
       {"candidates", candidates},

@@ -437,6 +437,34 @@ void accept_best(Diagnosis& d, const FloorInputs& in, bool at_floor = false) {
                                          d.accepted->effect + " explains the residual as a missing effect"});
 }
 
+// Above the declared floor, a better sensor is judged by the parameters, not by the mean square
+// it removes (most of that is the declared signal's error): against the published values, its
+// offsets nuisances (sensor_agreement.hpp). Where it agrees, it is no missing effect and is not
+// added; where it differs, or that cannot be told, it stays the accepted candidate.
+void judge_better_sensor(Diagnosis& d, const FloorInputs& in, double rate, int odmf) {
+  SensorAgreement agreement;
+  try {
+    agreement = sensor_agreement(in.model, in.declared, d.accepted->effect,
+                                 sensors_of(*d.accepted, in.model.candidate_effects()), in.segments,
+                                 rate, odmf, in.options.fit, in.run.announcement.preprocessing);
+  } catch (const InputError&) {
+    return;
+  }
+  if (!agreement.agrees()) return;
+  d.sensor_reaches = !d.partial;
+  std::string why =
+      "a better sensor of a declared signal, not a missing effect: " + agreement.statement();
+  if (d.partial)
+    why += "; its model leaves the " + d.partial->group +
+           format(" residual above its own floor (ratio of squares %.3g, at the floor up to %.3g)",
+                  d.partial->ratio, d.partial->upper_ratio);
+  d.refused.insert(d.refused.begin(), {d.accepted->effect, why});
+  d.sensor_error = std::move(agreement);
+  d.accepted.reset();
+  d.partial.reset();
+  d.better_sensor = false;
+}
+
 }  // namespace
 
 Materiality materiality(const NoiseFloor& declared, const NoiseFloor& extended) {
@@ -536,6 +564,10 @@ std::string Diagnosis::verdict_statement() const {
   std::string out;
   switch (verdict) {
     case Verdict::kAdequate: {
+      if (sensor_error)
+        return "adequate: the residual of " + screen.fit.model + " is above the noise floor (" +
+               floors + ") by an error of a declared signal, not a missing effect: " +
+               sensor_error->statement() + ", and its model reaches its own floor";
       out = "adequate: the residual of " + screen.fit.model + " is at the noise floor (" + floors + ")";
       if (hidden) out += "; note: " + hidden->statement();
       if (const CandidateScore* b = screen.best())
@@ -638,9 +670,12 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
     d.masked = true;
   } else {
     accept_best(d, floor_inputs);
+    if (d.accepted && d.better_sensor) judge_better_sensor(d, floor_inputs, rate, odmf);
   }
   d.inseparable = inseparable_effects(model, d.screen, d.accepted ? d.accepted->effect : "");
-  d.verdict = d.accepted && !d.partial ? Verdict::kExplained : Verdict::kStructureLeft;
+  d.verdict = d.accepted && !d.partial             ? Verdict::kExplained
+              : d.sensor_error && d.sensor_reaches ? Verdict::kAdequate
+                                                   : Verdict::kStructureLeft;
   d.signature = signature_of(signature_inputs(model, segments, d, rate, odmf, options), options);
   return d;
 }

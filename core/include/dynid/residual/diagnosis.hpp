@@ -60,6 +60,7 @@
 #include "dynid/model/model.hpp"
 #include "dynid/residual/effect_screen.hpp"
 #include "dynid/residual/noise_floor.hpp"
+#include "dynid/residual/sensor_agreement.hpp"
 #include "dynid/residual/separability.hpp"
 
 namespace dynid::residual {
@@ -166,6 +167,13 @@ struct Diagnosis {
   /// Structure a better sensor shows under the declared floor but too small to matter (above):
   /// the note beside an "adequate" verdict.
   std::optional<HiddenStructure> hidden;
+  /// Above the declared floor, the best candidate was a better sensor of a declared signal that
+  /// agrees with the published parameters, its offsets nuisances (sensor_agreement.hpp): what it
+  /// removes is that signal's own error, not a missing effect. It is refused, and the verdict is
+  /// "adequate" when its model reaches its own floor (`sensor_reaches`), else "structure left"
+  /// with what it leaves.
+  std::optional<SensorAgreement> sensor_error;
+  bool sensor_reaches = false;
   std::vector<RefusedCandidate> refused;  ///< significant candidates refused, with the reason
   Signature signature;
   /// Physical effects this run cannot rule out although they would bias the declared
