@@ -50,12 +50,13 @@
 #include <dynid/options/option_checks.hpp>
 
 #include "dynid/car/auxiliary.hpp"
-#include "dynid/car/live_merge.hpp"
-#include "dynid/car/log_source.hpp"
 #include "dynid/car/can_interface_follower.hpp"
 #include "dynid/car/chunk_file.hpp"
 #include "dynid/car/delivery.hpp"
+#include "dynid/car/live_merge.hpp"
+#include "dynid/car/log_source.hpp"
 #include "dynid/car/pipeline.hpp"
+#include "dynid/car/profile_check.hpp"
 #include "dynid/car/progress_display.hpp"
 #include "dynid/car/replay.hpp"
 #include "dynid/car/socketcan_source.hpp"
@@ -84,6 +85,7 @@ struct Options {
   std::string chunks_out;
   std::uint64_t max_frames = 0;  // live: stop after this many frames (0: only on a signal)
   std::vector<std::string> sources;  // --source NAME=FILE
+  bool check_profile = false;
 };
 
 // The replayed logs as paths, and as one name for messages ("a.log" or "a.MF4 + b.MF4").
@@ -472,6 +474,32 @@ int write_chunks(const Options& options) {
   return g_stop.load() ? kInterrupted : kOk;
 }
 
+// --check-profile: which models the profile can run and why not; with --replay, the log read
+// through the same pipeline (nothing spooled or sent) and each channel's rate and health
+// (profile_check.hpp). The report on stdout; exit 1 when a model cannot run.
+int check_profile_and_log(const Options& options) {
+  RunSources sources = run_profile(options);
+  const VehicleProfile& profile = sources.profile;
+  ProfileCheck check = dynid::car::check_profile(profile);
+  if (!options.replay.empty()) {
+    probe_log(options, profile);
+    std::vector<dynid::ingest::Chunk> chunks;
+    CarPipeline pipe(
+        profile, options.run.empty() ? "check" : options.run,
+        [&chunks](dynid::ingest::Chunk&& chunk) { chunks.push_back(std::move(chunk)); });
+    pipe.add_auxiliary(std::move(sources.samples));
+    Options fast = options;
+    fast.fast = true;  // a check reads the log at once, whatever --speed says
+    const std::string problem = replay_log(fast, pipe, [](const ReplayProgress&) {
+      if (g_stop.load()) throw Interrupted{};
+    });
+    if (!problem.empty()) spdlog::warn("{}", problem);
+    dynid::car::check_log(check, profile, replay_name(options), pipe, chunks);
+  }
+  std::fputs(check.text().c_str(), stdout);
+  return check.runs() ? kOk : kFailed;
+}
+
 int run(const Options& options, ProgressDisplay& display) {
   // Every input is checked before the spool is touched.
   const std::string cyclone_config = dynid::dds::config_uri(options.cyclone_config);
@@ -554,6 +582,12 @@ int main(int argc, char** argv) {
                  "overrides the profile's file)");
   app.add_option("--max-frames", o.max_frames, "live: stop after this many frames")
       ->check(input::within(1, kMaxFrames))->needs(can_opt);
+  app.add_flag(
+         "--check-profile", o.check_profile,
+         "send nothing: say which of the profile's models can run and why not; with --replay, "
+         "also each channel's rate, gaps and health on that log, and which models it can judge "
+         "(exit 1 when a model cannot run)")
+      ->excludes(can_opt);
   app.add_option("--spool", o.spool, "spool folder (default: the profile's [spool] directory)");
   app.add_option("--drain-timeout", o.drain_timeout, "seconds to wait for the last acknowledgements")
       ->check(input::within(0.0, kMaxSeconds));
@@ -567,11 +601,16 @@ int main(int argc, char** argv) {
     app.exit(e);
     return kFailed;
   }
+  if (o.check_profile && !o.chunks_out.empty()) {
+    std::fprintf(stderr,
+                 "dynid-car: --check-profile sends and writes nothing: drop --chunks-out\n");
+    return kFailed;
+  }
   if (!o.chunks_out.empty() && o.replay.empty() && o.can.empty()) {
     std::fprintf(stderr, "dynid-car: --chunks-out needs --replay or --can\n");
     return kFailed;
   }
-  if (o.chunks_out.empty() && o.cyclone_config.empty()) {
+  if (o.chunks_out.empty() && o.cyclone_config.empty() && !o.check_profile) {
     std::fprintf(stderr, "dynid-car: --cyclone-config is required (unless --chunks-out)\n");
     return kFailed;
   }
@@ -584,6 +623,11 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
+    if (o.check_profile) {
+      const int status = check_profile_and_log(o);
+      display.finish();
+      return status;
+    }
     if (!o.chunks_out.empty()) {
       const int status = write_chunks(o);
       display.finish();

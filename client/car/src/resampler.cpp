@@ -33,6 +33,7 @@ Resampler::Resampler(ResamplerConfig config, RowSink sink)
   channels_.resize(config_.channels);
   row_.resize(config_.channels);
   stats_.missing_by_channel.assign(config_.channels, 0);
+  stats_.samples_by_channel.assign(config_.channels, 0);
   origin_ = first_origin_ = config_.origin;
 }
 
@@ -67,6 +68,7 @@ void Resampler::end_piece() {
 
 void Resampler::push(std::size_t channel, double time, double value) {
   ++stats_.samples;
+  if (channel < stats_.samples_by_channel.size()) ++stats_.samples_by_channel[channel];
   observe(time);
   if (!origin_) start_piece(time);
   Channel& c = channels_.at(channel);

@@ -661,23 +661,26 @@ std::string sources_hint(const VehicleProfile& p, const std::vector<std::string>
 
 }  // namespace
 
-std::vector<std::string> models_lacking_channels(const VehicleProfile& p) {
+std::string lacking_channels(const VehicleProfile& p, std::size_t i) {
   const ingest::RunAnnouncement run = p.announcement("r");
   const std::function<bool(const std::string&)> provided = [&](const std::string& c) {
     return ingest::run_provides(run, c);
   };
+  const ingest::ModelSpec& spec = p.models.at(i);
+  const ingest::ChannelGaps gaps =
+      ingest::channel_gaps(*model::make_model(spec.model, spec.constants), spec, provided);
+  if (gaps.missing.empty()) return {};
+  std::string line = "models[" + std::to_string(i) + "] '" + spec.model + "' needs " +
+                     described(gaps.missing) + ", which this run does not have";
+  if (!gaps.optional_absent.empty())
+    line += " (it would also read " + described(gaps.optional_absent) + ", optional, absent too)";
+  return line + sources_hint(p, gaps.missing, provided);
+}
+
+std::vector<std::string> models_lacking_channels(const VehicleProfile& p) {
   std::vector<std::string> out;
-  for (std::size_t i = 0; i < p.models.size(); ++i) {
-    const ingest::ModelSpec& spec = p.models[i];
-    const ingest::ChannelGaps gaps =
-        ingest::channel_gaps(*model::make_model(spec.model, spec.constants), spec, provided);
-    if (gaps.missing.empty()) continue;
-    std::string line = "models[" + std::to_string(i) + "] '" + spec.model + "' needs " +
-                       described(gaps.missing) + ", which this run does not have";
-    if (!gaps.optional_absent.empty())
-      line += " (it would also read " + described(gaps.optional_absent) + ", optional, absent too)";
-    out.push_back(line + sources_hint(p, gaps.missing, provided));
-  }
+  for (std::size_t i = 0; i < p.models.size(); ++i)
+    if (std::string line = lacking_channels(p, i); !line.empty()) out.push_back(std::move(line));
   return out;
 }
 

@@ -86,6 +86,7 @@ struct ResamplerStats {
   std::uint64_t rows = 0;
   std::uint64_t invalid_rows = 0;
   std::vector<std::uint64_t> missing_by_channel;  ///< rows where this channel had no value
+  std::vector<std::uint64_t> samples_by_channel;  ///< samples given, per channel
   std::uint64_t pieces_ended = 0;  ///< grid pieces ended by a time jump or a silence
 };
 

@@ -160,6 +160,8 @@ struct VehicleProfile {
 /// with the optional channels it also lacks and the declared sources not given that have them.
 /// Empty when every model can run. dynid-car refuses such a run before anything is sent.
 std::vector<std::string> models_lacking_channels(const VehicleProfile& profile);
+/// The line of models_lacking_channels for profile.models[i], empty when it can run.
+std::string lacking_channels(const VehicleProfile& profile, std::size_t i);
 
 VehicleProfile load_vehicle_profile(const std::filesystem::path& path);
 /// Parses profile text; `source` names it in messages and relative paths resolve against its
