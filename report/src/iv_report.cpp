@@ -59,25 +59,28 @@ std::string iv_json(const residual::IvFit& f) {
                           {"difference_std", finite(f.difference_std(j))},
                           {"z", finite(apart(f, j))}});
   }
-  return nlohmann::json{{"model", f.model},
-                        {"effects", f.effects},
-                        {"lag_rows", f.lag_rows},
-                        {"rows", f.rows},
-                        {"rows_without_partner", f.rows_without_partner},
-                        {"refused", f.refused},
-                        {"reason", f.reason},
-                        {"smallest_canonical_correlation", finite(f.smallest_canonical_correlation)},
-                        {"instrument_f", finite(f.instrument_f)},
-                        {"parameters", parameters},
-                        {"dwh",
-                         {{"statistic", finite(f.dwh.statistic)},
-                          {"degrees_of_freedom", f.dwh.degrees_of_freedom},
-                          {"p_value", finite(f.dwh.p_value)},
-                          {"level", f.dwh.level},
-                          {"bandwidth", f.dwh.bandwidth},
-                          {"rejects", f.dwh.rejects}}},
-                        {"replaces_least_squares", f.replaces_least_squares()},
-                        {"statement", f.statement()}}
+  return nlohmann::json{
+      {"model", f.model},
+      {"effects", f.effects},
+      {"lag_rows", f.lag_rows},
+      {"rows", f.rows},
+      {"residual_rms", finite(f.residual_rms)},
+      {"ls_residual_rms", finite(f.ls_residual_rms)},
+      {"rows_without_partner", f.rows_without_partner},
+      {"refused", f.refused},
+      {"reason", f.reason},
+      {"smallest_canonical_correlation", finite(f.smallest_canonical_correlation)},
+      {"instrument_f", finite(f.instrument_f)},
+      {"parameters", parameters},
+      {"dwh",
+       {{"statistic", finite(f.dwh.statistic)},
+        {"degrees_of_freedom", f.dwh.degrees_of_freedom},
+        {"p_value", finite(f.dwh.p_value)},
+        {"level", f.dwh.level},
+        {"bandwidth", f.dwh.bandwidth},
+        {"rejects", f.dwh.rejects}}},
+      {"replaces_least_squares", f.replaces_least_squares()},
+      {"statement", f.statement()}}
       .dump();
 }
 

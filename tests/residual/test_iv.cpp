@@ -118,6 +118,18 @@ TEST(IvFit, OnNoiseFreeRowsEqualsLeastSquaresAndTheTruth) {
   }
   EXPECT_NEAR(iv.value(0), kScale, 1e-9);
   EXPECT_NEAR(iv.value(1), kOffset, 1e-9);
+  // Rows weighted by least squares' own 1/sigma: its RMS is about 1 (rounding, scaled), IV's not
+  // below.
+  EXPECT_GE(iv.residual_rms, iv.ls_residual_rms * (1.0 - 1e-9));
+}
+
+// The residuals' RMS on the same rows: least squares minimises it, so IV's is never below it,
+// and with noise in a regressor it is above by more than rounding.
+TEST(IvFit, ItsResidualIsNeverBelowLeastSquaresOnTheSameRows) {
+  const IvFit iv = iv_of(run_with_noise(7, 0.05, 0.05));
+  ASSERT_FALSE(iv.refused) << iv.reason;
+  EXPECT_GT(iv.ls_residual_rms, 0.0);
+  EXPECT_GT(iv.residual_rms, iv.ls_residual_rms * (1.0 + 1e-9));
 }
 
 struct Tally {

@@ -206,6 +206,8 @@ void estimate(const Stacked& s, const Eigen::MatrixXd& qz, const Eigen::VectorXd
   const Eigen::MatrixXd difference_scores =
       ((zs * m_inverse.transpose() - ws * g_inverse).array().colwise() * e_ls.array()).matrix();
   const Eigen::MatrixXd v_d = long_run(s, difference_scores, odmf, bandwidth);
+  fit.residual_rms = std::sqrt(e_iv.squaredNorm() / static_cast<double>(s.y.size()));
+  fit.ls_residual_rms = std::sqrt(e_ls.squaredNorm() / static_cast<double>(s.y.size()));
   fit.value = unscaled(iv, scale, used, width);
   fit.ls_value = unscaled(ls, scale, used, width);
   fit.std = unscaled(textbook.diagonal().cwiseMax(0.0).cwiseSqrt(), scale, used, width);
