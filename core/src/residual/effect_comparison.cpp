@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include <boost/math/distributions/normal.hpp>
+
 #include "dynid/model/parameter_status.hpp"
 
 namespace dynid::residual {
@@ -28,6 +30,21 @@ double EffectComparison::in_sample_drop() const {
 }
 double EffectComparison::held_out_drop() const {
   return drop(before.weighted_rms_held_out, after.weighted_rms_held_out);
+}
+
+double hausman_distance(const ParameterChange& p, bool sharpens) {
+  if (!std::isfinite(p.before) || !std::isfinite(p.after)) return kNaN;
+  const double difference = p.std_before * p.std_before - p.std_after * p.std_after;
+  double variance = sharpens ? difference : -difference;
+  if (!(variance > 0.0)) variance = p.std_before * p.std_before + p.std_after * p.std_after;
+  if (!(variance > 0.0)) return kNaN;
+  return std::abs(p.after - p.before) / std::sqrt(variance);
+}
+
+double hausman_bound(std::size_t compared) {
+  constexpr double kFamilyErrorRate = 0.01;
+  return boost::math::quantile(boost::math::complement(
+      boost::math::normal(), kFamilyErrorRate / (2.0 * static_cast<double>(compared))));
 }
 
 EffectComparison compare_effect(const model::Model& model, const std::vector<std::string>& declared,

@@ -3,17 +3,15 @@
 #include <cmath>
 #include <cstdio>
 
-#include <boost/math/distributions/normal.hpp>
-
 #include "dynid/error.hpp"
 #include "dynid/model/channel_catalogue.hpp"
+#include "dynid/residual/effect_comparison.hpp"
 #include "dynid/residual/iv_fit.hpp"
 #include "dynid/residual/sensor_offset.hpp"
 
 namespace dynid::residual {
 namespace {
 
-constexpr double kFamilyErrorRate = 0.01;
 // The offset of each fit's shift, in the sensor's unit: any value gives the same parabola and
 // lines for a model linear in the sensor; 1 keeps both far above rounding.
 constexpr double kShift = 1.0;
@@ -165,35 +163,24 @@ SensorAgreement sensor_agreement(const model::Model& model,
     value += slope * offset;
     variance += slope.array().square().matrix() * offset_variance;
   }
-  std::size_t count = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    const bool finite = std::isfinite(value(i)) && std::isfinite(published.value(i)) &&
-                        std::isfinite(published.std(i));
-    if (!compared[static_cast<std::size_t>(i)])
-      out.not_compared.push_back(declared_fit.parameters[static_cast<std::size_t>(i)].name);
-    count += compared[static_cast<std::size_t>(i)] && finite ? 1 : 0;
-  }
-  if (count == 0) return out;
-  out.bound = boost::math::quantile(boost::math::complement(
-      boost::math::normal(), kFamilyErrorRate / (2.0 * static_cast<double>(count))));
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (!compared[static_cast<std::size_t>(i)] || !std::isfinite(value(i)) ||
-        !std::isfinite(published.value(i)) || !std::isfinite(published.std(i)))
-      continue;
     const model::ParameterInfo& info = declared_fit.parameters[static_cast<std::size_t>(i)];
-    const double p2 = published.std(i) * published.std(i);
-    double v = p2 - variance(i);
-    if (!(v > 0.0)) v = p2 + variance(i);
-    ComparedParameter cp{info.name,
-                         info.unit,
-                         published.value(i),
-                         published.std(i),
-                         value(i),
-                         std::sqrt(variance(i)),
-                         0.0};
-    cp.moved = v > 0.0 ? std::abs(value(i) - published.value(i)) / std::sqrt(v) : 0.0;
-    out.compared.push_back(cp);
+    if (!compared[static_cast<std::size_t>(i)]) {
+      out.not_compared.push_back(info.name);
+      continue;
+    }
+    if (!std::isfinite(value(i)) || !std::isfinite(published.value(i)) ||
+        !std::isfinite(published.std(i)))
+      continue;
+    // Hausman's comparison with the published value as "before" and the sharper value "after".
+    ParameterChange change{info.name,        info.unit, published.value(i),
+                           published.std(i), value(i),  std::sqrt(variance(i)),
+                           std::nullopt};
+    const double moved = hausman_distance(change, /*sharpens=*/true);
+    out.compared.push_back({info.name, info.unit, published.value(i), published.std(i), value(i),
+                            std::sqrt(variance(i)), std::isnan(moved) ? 0.0 : moved});
   }
+  if (!out.compared.empty()) out.bound = hausman_bound(out.compared.size());
   return out;
 }
 

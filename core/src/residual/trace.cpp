@@ -3,8 +3,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include <boost/math/distributions/normal.hpp>
-
 #include "dynid/cancellation.hpp"
 #include "dynid/error.hpp"
 
@@ -52,25 +50,15 @@ struct LargestMove {
   }
 };
 
-// `sharpens`: the candidate is a better sensor, efficient under the hypothesis, so the difference's
-// variance is std_before^2 - std_after^2; else it is a column more, the declared fit the efficient
-// one, and the variance std_after^2 - std_before^2. Where that is not positive, the sum
-// (conservative).
+// `sharpens`: the candidate is a better sensor, efficient under the hypothesis (hausman_distance).
 LargestMove largest_move(const EffectComparison& c, bool sharpens) {
   LargestMove out;
   for (const ParameterChange& p : c.parameters)
     out.declared += std::isfinite(p.before) && std::isfinite(p.after) ? 1 : 0;
   if (out.declared == 0) return out;
-  constexpr double kFamilyErrorRate = 0.01;
-  out.bound = boost::math::quantile(boost::math::complement(
-      boost::math::normal(), kFamilyErrorRate / (2.0 * static_cast<double>(out.declared))));
+  out.bound = hausman_bound(out.declared);
   for (const ParameterChange& p : c.parameters) {
-    if (!std::isfinite(p.before) || !std::isfinite(p.after)) continue;
-    const double difference = p.std_before * p.std_before - p.std_after * p.std_after;
-    double variance = sharpens ? difference : -difference;
-    if (!(variance > 0.0)) variance = p.std_before * p.std_before + p.std_after * p.std_after;
-    if (!(variance > 0.0)) continue;
-    const double moved = std::abs(p.after - p.before) / std::sqrt(variance);
+    const double moved = hausman_distance(p, sharpens);
     if (moved > out.moved) out.parameter = &p, out.moved = moved;
   }
   return out;

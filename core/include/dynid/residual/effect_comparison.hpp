@@ -29,6 +29,17 @@ struct ParameterChange {
   double error_after_percent() const;
 };
 
+/// Hausman's comparison of one parameter's two values (trace.hpp, sensor_agreement.hpp): how far
+/// `after` lies from `before` in std of their difference. `sharpens`: `after` is the efficient
+/// estimate under the hypothesis (a better sensor), the difference's variance std_before^2 -
+/// std_after^2; else (a column more) std_after^2 - std_before^2. Where that is not positive, the
+/// sum (conservative). NaN when either value is not finite or no variance is positive.
+double hausman_distance(const ParameterChange& p, bool sharpens);
+
+/// The bound on the largest hausman_distance over `compared` parameters at a 1 % family error
+/// rate: the two-sided normal quantile at 1 % / compared (Bonferroni).
+double hausman_bound(std::size_t compared);
+
 struct EffectComparison {
   std::string effect;
   ModelFit before;

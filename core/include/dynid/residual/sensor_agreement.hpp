@@ -30,7 +30,8 @@
 // read better", both estimate the same parameters and the better sensor's are the efficient ones,
 // so the difference's variance is var_published - var_with_sensor (the sum where that is not
 // positive: conservative). The sensor agrees when no compared parameter moves by more than the
-// normal quantile at 1 % over the compared parameters (Bonferroni), the rule of trace.hpp.
+// normal quantile at 1 % over the compared parameters (Bonferroni): hausman_distance and
+// hausman_bound (effect_comparison.hpp), the rule of trace.hpp.
 // Published values: IV's (HAC std) where IV replaces least squares on the declared model, else
 // least squares'. SIMEX, which publication.hpp may put in IV's place, is not computed here: it
 // needs the noise floor's draws; IV is its reference (simex_against_iv.hpp).
