@@ -207,6 +207,7 @@ TEST(IvFit, WeakInstrumentsAreRefusedWithTheReason) {
   EXPECT_NE(iv.reason.find("weak instruments"), std::string::npos) << iv.reason;
   EXPECT_NE(iv.reason.find("sensor_scale"), std::string::npos) << iv.reason;
   EXPECT_TRUE(std::isnan(iv.value(0)));
+  EXPECT_TRUE(std::isnan(iv.residual_rms)) << "a refused fit has no residual to report";
   std::printf("%s\n", iv.reason.c_str());
 }
 

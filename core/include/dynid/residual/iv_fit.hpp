@@ -68,6 +68,7 @@
 // most. The rows' correlation makes n overstate
 // the information: a stated limit, the check is a floor, not a guarantee.
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -117,11 +118,12 @@ struct IvFit {
   Eigen::VectorXd hac_std;    ///< HAC sandwich
   Eigen::VectorXd ls_value;   ///< weighted LS on the same rows
   /// RMS of the weighted rows' IV residual y - W theta_IV, and of least squares' on the same rows
-  /// (never above IV's), in the rows' weighted units (least squares' 1/sigma: about 1). Compared
+  /// (never above IV's), in the rows' weighted units (least squares' 1/sigma: about 1). NaN when
+  /// IV was refused (JSON null), as the values. Compared
   /// across fits of one run with another effect (a step's time), IV's is the criterion that least
   /// squares' noise bias does not move (docs/results/RESIDUAL.md, a load taken off at a stop).
-  double residual_rms = 0.0;
-  double ls_residual_rms = 0.0;
+  double residual_rms = std::numeric_limits<double>::quiet_NaN();
+  double ls_residual_rms = std::numeric_limits<double>::quiet_NaN();
   /// HAC std of value - ls_value (the square root of V_d's diagonal): per parameter, how far
   /// apart the two may lie by chance under DWH's null; NaN where LS identifies nothing.
   Eigen::VectorXd difference_std;
