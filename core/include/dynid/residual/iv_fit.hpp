@@ -118,10 +118,12 @@ struct IvFit {
   Eigen::VectorXd hac_std;    ///< HAC sandwich
   Eigen::VectorXd ls_value;   ///< weighted LS on the same rows
   /// RMS of the weighted rows' IV residual y - W theta_IV, and of least squares' on the same rows
-  /// (never above IV's), in the rows' weighted units (least squares' 1/sigma: about 1). NaN when
-  /// IV was refused (JSON null), as the values. Compared
-  /// across fits of one run with another effect (a step's time), IV's is the criterion that least
-  /// squares' noise bias does not move (docs/results/RESIDUAL.md, a load taken off at a stop).
+  /// (never above IV's), in the rows' weighted units: this configuration's own least-squares
+  /// 1/sigma, so least squares' reads about 1 and IV's says how much IV's residual exceeds least
+  /// squares' on the same configuration. Not a fit's absolute size: two configurations (a step at
+  /// two times) are weighted by two sigmas, and their residual_rms values are not comparable as
+  /// fits (docs/results/RESIDUAL.md, a load taken off at a stop). NaN when IV was refused (JSON
+  /// null), as the values.
   double residual_rms = std::numeric_limits<double>::quiet_NaN();
   double ls_residual_rms = std::numeric_limits<double>::quiet_NaN();
   /// HAC std of value - ls_value (the square root of V_d's diagonal): per parameter, how far
