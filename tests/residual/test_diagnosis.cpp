@@ -26,6 +26,7 @@ constexpr double kG = 9.80665;
 // Units of the catalogue (docs/CHANNELS.md): models check them.
 std::string unit_of(const std::string& channel) {
   if (channel == "ax" || channel == "ay") return "m/s^2";
+  if (channel == "wheel_torque") return "N m";
   return channel == "yaw_rate" ? "rad/s" : "m/s";
 }
 
@@ -467,6 +468,73 @@ TEST(Diagnosis, AStepOfAParameterIsLocatedAndSized) {
   EXPECT_NEAR(c.parameters.back().after, 0.25, 4.0 * c.parameters.back().std_after);
   EXPECT_NEAR(c.parameters[0].after, 1.02, 4.0 * c.parameters[0].std_after);  // the value before the step
   EXPECT_EQ(diagnose(*model, {}, clean).verdict, Verdict::kAdequate);
+}
+
+// A load taken off at a stop, on a run whose speed is differentiated from noisy wheel speeds and
+// whose accelerometer is sharp: driving with strong accelerations (0-50 s), a coast-down with the
+// wheel torque at zero (50-100 s), a stop without valid data (100-112 s, the load of 200 kg taken
+// off at 106 s), driving again. The mass's noise bias (errors in d_vx) differs between driving and
+// coasting, so on the d_vx rows a mass step fits the phase boundary as well; the diagnosis judges
+// the mass's time course with the accelerometer declared (diagnosis.hpp), where the step is
+// located at the stop.
+ingest::RecordedRun wheel_run(std::uint64_t seed, double mass_after) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01;
+  constexpr double kRadius = 0.3, kHalfRhoScx = 0.5 * 1.2 * 0.7, kRolling = 150.0;
+  const Eigen::Index n = 18000;
+  Eigen::VectorXd vx(n), ax(n), torque(n);
+  ingest::RecordedRun run;
+  double v = 12.0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) / kRate;
+    const double mass = t < 106.0 ? 1500.0 : mass_after;
+    const bool coasting = t >= 50.0 && t < 100.0;
+    if (t >= 112.0 && t - 1.0 / kRate < 112.0) v = 12.0;
+    const double resistance = kHalfRhoScx * v * v + kRolling;
+    const double a =
+        coasting ? -resistance / mass : 1.2 * std::sin(0.5 * t) + 0.6 * std::sin(1.3 * t + 0.4);
+    const double force = coasting ? 0.0 : mass * a + resistance;
+    vx(k) = v + 0.02 * n01(rng);
+    ax(k) = a + 0.03 + 0.02 * n01(rng);
+    torque(k) = kRadius * force + 3.0 * n01(rng);
+    v += a / kRate;
+  }
+  run = recorded({{"vx", vx}, {"ax", ax}, {"wheel_torque", torque}});
+  for (Eigen::Index k = 10000; k < 11200; ++k) run.valid[static_cast<std::size_t>(k)] = 0;
+  return run;
+}
+
+TEST(Diagnosis, AParametersTimeCourseIsJudgedOnTheSharperSensorsRows) {
+  const auto model =
+      model::make_model("longitudinal_wheel", {{"wheel_radius", 0.3}, {"air_density", 1.2}});
+  const Diagnosis d = diagnose(*model, {}, wheel_run(3, 1300.0));
+  ASSERT_EQ(d.verdict, Verdict::kExplained) << d.statement();
+  const VaryingParameter step = parse_varying_effect(d.accepted->effect, *model);
+  ASSERT_EQ(step.kind, VaryingParameter::Kind::kStep) << d.statement();
+  EXPECT_EQ(step.parameter, "mass");
+  EXPECT_LE(d.accepted->located_from_s, 106.0) << d.accepted->finding;
+  EXPECT_GE(d.accepted->located_to_s, 106.0) << d.accepted->finding;
+  EXPECT_NEAR(d.accepted->coefficient, -200.0, 10.0) << d.accepted->finding;
+  EXPECT_NE(d.accepted->finding.find("judged with road_grade_accelerometer declared"),
+            std::string::npos)
+      << d.accepted->finding;
+  // Why: on the d_vx rows the step is located at the shift from driving to coasting, 55 s early.
+  const auto on_dvx = std::find_if(
+      d.screen.candidates.begin(), d.screen.candidates.end(), [](const CandidateScore& c) {
+        return c.effect.rfind("step:mass@", 0) == 0 && std::isfinite(c.located_from_s) &&
+               c.finding.find("judged with") == std::string::npos;
+      });
+  ASSERT_NE(on_dvx, d.screen.candidates.end());
+  EXPECT_LT(on_dvx->located_to_s, 60.0) << on_dvx->finding;
+  const auto refused =
+      std::find_if(d.refused.begin(), d.refused.end(),
+                   [&](const RefusedCandidate& r) { return r.effect == on_dvx->effect; });
+  ASSERT_NE(refused, d.refused.end()) << d.statement();
+  EXPECT_NE(refused->reason.find("time course is judged on the rows with road_grade_accelerometer"),
+            std::string::npos)
+      << refused->reason;
+  const Diagnosis clean = diagnose(*model, {}, wheel_run(3, 1500.0));
+  EXPECT_FALSE(clean.accepted && is_varying_effect(clean.accepted->effect)) << clean.statement();
 }
 
 // The speed signal recorded 200 ms late: the delay is found on the raw grid, named in ms with its
