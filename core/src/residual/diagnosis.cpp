@@ -465,6 +465,7 @@ void time_course_on_sharper_rows(Diagnosis& d, const FloorInputs& in, const std:
     if (c.evaluated && c.kind == CandidateKind::kVarying && is_varying_effect(c.effect) &&
         parse_varying_effect(c.effect, in.model).parameter == parameter)
       options.only.push_back(c.effect);
+  if (options.only.empty()) return;  // an empty list would test every candidate
   std::vector<std::string> sharper = in.declared;
   sharper.push_back(sensor);
   ScreenResult again;
@@ -479,8 +480,8 @@ void time_course_on_sharper_rows(Diagnosis& d, const FloorInputs& in, const std:
   if (!own.below.empty() || (!own.lowers && !own.materiality.material())) return;
   CandidateScore chosen = *best;
   chosen.finding += std::string(chosen.finding.empty() ? "" : "; ") + "judged with " + sensor +
-                    " declared (a better sensor of a declared signal: its rows carry less of that "
-                    "signal's noise)";
+                    " declared (a better sensor of a declared signal, whose rows carry less of its "
+                    "noise): these figures are that model's";
   d.refused.push_back(
       {d.accepted->effect, "its parameter's time course is judged on the rows with " + sensor +
                                " declared, where " + chosen.effect + " explains more"});
