@@ -476,15 +476,20 @@ void time_course_on_sharper_rows(Diagnosis& d, const FloorInputs& in, const std:
   }
   const CandidateScore* best = again.best();
   if (best == nullptr || best->effect == d.accepted->effect) return;
+  if (!bounds_refusal(*best, again.fit, in.model.candidate_effects()).empty()) return;
   const OwnFloor own = own_floor(*best, in, d.floor);
   if (!own.below.empty() || (!own.lowers && !own.materiality.material())) return;
   CandidateScore chosen = *best;
   chosen.finding += std::string(chosen.finding.empty() ? "" : "; ") + "judged with " + sensor +
                     " declared (a better sensor of a declared signal, whose rows carry less of its "
                     "noise): these figures are that model's";
+  // Its aliases are on that model's columns, not the declared ones (separability.hpp reads them
+  // against the declared fit): left out.
+  chosen.alias.clear();
   d.refused.push_back(
       {d.accepted->effect, "its parameter's time course is judged on the rows with " + sensor +
-                               " declared, where " + chosen.effect + " explains more"});
+                               " declared, where the best of " + parameter +
+                               "'s steps and drifts is " + chosen.effect});
   // Listed among the candidates, before the one it replaces, with the figures of the rows it
   // was judged on (its finding says which).
   auto first =
@@ -694,8 +699,7 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
   const double rate = run.announcement.sample_rate_hz;
   const int odmf = run.announcement.preprocessing.odmf;
   Diagnosis d;
-  const ScreenOptions& screen = options.screen;
-  d.screen = screen_effects(model, declared, segments, rate, odmf, screen);
+  d.screen = screen_effects(model, declared, segments, rate, odmf, options.screen);
   const ls::Estimate& fit = d.screen.fit.estimate;
   for (std::size_t j = 0; j < d.screen.fit.parameters.size(); ++j) {
     const auto i = static_cast<Eigen::Index>(j);
@@ -732,7 +736,7 @@ Diagnosis diagnose(const model::Model& model, const std::vector<std::string>& de
     std::string passed_over;
     accept_best(d, floor_inputs, false, &passed_over);
     if (d.accepted && !d.better_sensor && !passed_over.empty())
-      time_course_on_sharper_rows(d, floor_inputs, passed_over, screen, rate, odmf);
+      time_course_on_sharper_rows(d, floor_inputs, passed_over, options.screen, rate, odmf);
     if (d.accepted && d.better_sensor) judge_better_sensor(d, floor_inputs, rate, odmf);
   }
   d.inseparable = inseparable_effects(model, d.screen, d.accepted ? d.accepted->effect : "");
