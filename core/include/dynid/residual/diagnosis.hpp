@@ -47,8 +47,9 @@
 // A parameter's time course on the sharper rows: above the floor, when the accepted missing
 // effect is a step or a drift of a parameter and a better sensor was passed over for it, the
 // screen of that parameter's varying candidates is run again with the better sensor declared
-// (its steps located on those rows), and its best is accepted instead when it is material and
-// does not fit noise on the declared rows; the first choice is refused with the reason. Least
+// (its steps located on those rows), and its best is accepted instead when it keeps the
+// parameters within their bounds there, is material and does not fit noise on the declared rows;
+// the first choice is refused with the reason. Least
 // squares' noise bias from a differentiated regressor differs between phases of a run, so on
 // the noisy rows a step fits a phase boundary too (diagnosis.cpp, docs/RESIDUAL.md step 6).
 //
