@@ -483,7 +483,6 @@ ingest::RecordedRun wheel_run(std::uint64_t seed, double mass_after) {
   constexpr double kRadius = 0.3, kHalfRhoScx = 0.5 * 1.2 * 0.7, kRolling = 150.0;
   const Eigen::Index n = 18000;
   Eigen::VectorXd vx(n), ax(n), torque(n);
-  ingest::RecordedRun run;
   double v = 12.0;
   for (Eigen::Index k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) / kRate;
@@ -499,7 +498,7 @@ ingest::RecordedRun wheel_run(std::uint64_t seed, double mass_after) {
     torque(k) = kRadius * force + 3.0 * n01(rng);
     v += a / kRate;
   }
-  run = recorded({{"vx", vx}, {"ax", ax}, {"wheel_torque", torque}});
+  ingest::RecordedRun run = recorded({{"vx", vx}, {"ax", ax}, {"wheel_torque", torque}});
   for (Eigen::Index k = 10000; k < 11200; ++k) run.valid[static_cast<std::size_t>(k)] = 0;
   return run;
 }

@@ -450,12 +450,13 @@ void accept_best(Diagnosis& d, const FloorInputs& in, bool at_floor = false,
 // differentiated from the wheel speeds) depends on how the run excites the parameter, so it
 // differs between the run's phases, and on the noisy rows a parameter seems to change where the
 // phase changes. Measured on an independently written car (docs/results/RESIDUAL.md): clean runs
-// gave least-squares mass steps of -21 kg and -226 kg at a shift to neutral, and a load taken off
-// at a stop (95.7 s) was located at the shift to neutral 60 s earlier (residual RMS 100.4 against
-// 103.9 N at the stop), while the same model with the accelerometer in d_vx's place fitted the
-// stop better (26.7 against 27.7 N) and located the step there. The choice made on the sharper
-// rows is accepted when it is material and does not fit the declared signals' noise on the
-// declared rows (its own floor, as any candidate); else the first choice stands.
+// gave least-squares mass steps of -21 kg and -226 kg at drive/coast boundaries, and a load taken
+// off at a stop (95.7 s) was located at the shift to neutral 60 s earlier (residual RMS 100.4
+// against 103.9 N at the stop), while the same model with the accelerometer in d_vx's place fitted
+// the stop better (26.7 against 27.7 N) and located the step there. The choice made on the sharper
+// rows is accepted when it keeps the parameters within their bounds there, is material and does
+// not fit the declared signals' noise on the declared rows (its own floor, as any candidate);
+// else the first choice stands.
 void time_course_on_sharper_rows(Diagnosis& d, const FloorInputs& in, const std::string& sensor,
                                  const ScreenOptions& screen, double rate, int odmf) {
   if (!is_varying_effect(d.accepted->effect)) return;
