@@ -31,6 +31,7 @@ ResidualSeries series_of(const detail::FoldedRows& rows, const detail::Evaluatio
   ResidualSeries s;
   s.group = rows.groups[g];
   s.time_s = rows.collected.time_s[g];
+  s.grid_index = rows.collected.grid_index[g];
   s.measured = all.col(width);
   s.residual = s.measured - all.leftCols(width) * e.x;
   const Eigen::Index effect_columns = rows.last_effect_end - rows.last_effect_first;

@@ -39,6 +39,9 @@ class BodyModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override { return {"fx", "fy", "fz", "mx", "my", "mz"}; }
+  std::string group_unit(const std::string& group) const override {
+    return group.front() == 'f' ? "N" : "N m";
+  }
   std::vector<std::string> measured_side() const override;
 
   /// The 6x10 regressor (venture §2.4) for specific force a, rates w, rate derivatives dw.

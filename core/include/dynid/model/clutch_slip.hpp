@@ -71,6 +71,7 @@ class ClutchSlipModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override { return {"engine"}; }
+  std::string group_unit(const std::string&) const override { return "N m"; }
   std::vector<std::string> measured_side() const override { return {"engine_torque"}; }
   std::optional<double> stribeck_speed() const { return stribeck_speed_; }
   /// At least stick_margin on both sides (near_stick), and the default.

@@ -29,6 +29,7 @@ class KinematicModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override;
+  std::string group_unit(const std::string&) const override { return "m/s^2"; }
   std::vector<std::string> measured_side() const override;
 
  protected:

@@ -67,6 +67,11 @@ class LateralBicycleModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override { return {"lateral", "yaw"}; }
+  /// Per unit mass without a mass: ay (m/s^2) and the yaw moment over the mass (m^2/s^2).
+  std::string group_unit(const std::string& group) const override {
+    if (group == "lateral") return mass_ ? "N" : "m/s^2";
+    return mass_ ? "N m" : "m^2/s^2";
+  }
   std::vector<std::string> measured_side() const override { return {"ay"}; }
 
  protected:

@@ -30,6 +30,7 @@ class LockedDrivelineModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override { return {"driveline"}; }
+  std::string group_unit(const std::string&) const override { return "N m"; }
   std::vector<std::string> measured_side() const override { return {"engine_torque"}; }
   long gear() const { return gear_; }
 

@@ -60,6 +60,7 @@ class LongitudinalModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override { return {"longitudinal"}; }
+  std::string group_unit(const std::string&) const override { return "N"; }  // F_drive
   std::vector<std::string> measured_side() const override;
 
  protected:

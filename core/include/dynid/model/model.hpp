@@ -106,6 +106,9 @@ class Model {
   virtual std::vector<ParameterInfo> parameters() const = 0;
   virtual std::vector<ChannelNeed> channels() const = 0;
   virtual std::vector<std::string> groups() const = 0;
+  /// The SI unit of group `group`'s measured side y, and so of its fitted values and residual
+  /// ("N", "N m", "m/s^2"): what an export or a plot labels them with. `group` is one of groups().
+  virtual std::string group_unit(const std::string& group) const = 0;
   /// The model's physical candidate effects (the generic dictionary is added by
   /// dictionary_effects(), see effects.hpp).
   virtual std::vector<Effect> candidate_effects() const = 0;

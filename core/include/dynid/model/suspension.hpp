@@ -28,6 +28,7 @@ class SuspensionModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override { return {"suspension"}; }
+  std::string group_unit(const std::string&) const override { return "N"; }
   std::vector<std::string> measured_side() const override { return {"susp_force_" + corner_}; }
 
  protected:

@@ -23,6 +23,7 @@ class TyreVerticalModel final : public RowModel {
   std::vector<ParameterInfo> parameters() const override;
   std::vector<ChannelNeed> channels() const override;
   std::vector<std::string> groups() const override { return {"tyre"}; }
+  std::string group_unit(const std::string&) const override { return "N"; }
   std::vector<std::string> measured_side() const override { return {"tyre_force_z_" + corner_}; }
 
  protected:

@@ -40,6 +40,7 @@ struct GroupFit {
 struct ResidualSeries {
   std::string group;
   std::vector<double> time_s;   ///< run time of each row (run grid index / sample rate)
+  std::vector<Eigen::Index> grid_index;  ///< the run grid index of each row
   Eigen::VectorXd measured;     ///< y
   Eigen::VectorXd residual;     ///< y - W x
   /// The fitted contribution of the last effect's columns (W_effect x_effect); empty without
