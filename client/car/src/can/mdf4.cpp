@@ -6,6 +6,8 @@
 #include <cstring>
 #include <fstream>
 #include <set>
+#include <string_view>
+#include <utility>
 
 #include <zlib.h>
 
@@ -208,7 +210,31 @@ Mdf4File::Block Mdf4File::block(std::uint64_t offset, std::string_view expect) c
   return b;
 }
 
-// ##TX: the text; ##MD: its <TX> element (the XML's comment text) or the whole XML.
+namespace {
+
+// XML's five predefined entities in an ##MD's <TX> text; any other '&' is kept as it is.
+std::string xml_unescaped(const std::string& s) {
+  static constexpr std::pair<std::string_view, char> kEntities[] = {
+      {"&lt;", '<'}, {"&gt;", '>'}, {"&amp;", '&'}, {"&quot;", '"'}, {"&apos;", '\''}};
+  std::string out;
+  for (std::size_t k = 0; k < s.size();) {
+    bool replaced = false;
+    for (const auto& [entity, c] : kEntities)
+      if (s.compare(k, entity.size(), entity) == 0) {
+        out += c;
+        k += entity.size();
+        replaced = true;
+        break;
+      }
+    if (!replaced) out += s[k++];
+  }
+  return out;
+}
+
+}  // namespace
+
+// ##TX: the text; ##MD: its <TX> element (the XML's comment text, entities replaced) or the whole
+// XML.
 std::string Mdf4File::text(std::uint64_t link) const {
   if (link == 0) return {};
   const Block b = block(link, "TXMD");
@@ -217,7 +243,7 @@ std::string Mdf4File::text(std::uint64_t link) const {
   if (b.id == "MD") {
     const auto open = s.find("<TX>"), close = s.find("</TX>");
     if (open != std::string::npos && close != std::string::npos && close > open)
-      s = s.substr(open + 4, close - open - 4);
+      s = xml_unescaped(s.substr(open + 4, close - open - 4));
   }
   // Names are kept: many channels naming one huge text must not multiply it in memory.
   text_kept_ += s.size();
@@ -242,6 +268,7 @@ void Mdf4File::parse() {
   const std::uint64_t start = u64(hd.data);
   if (start > static_cast<std::uint64_t>(INT64_MAX / 2)) fail(kIdBytes, "start time out of range");
   start_ns_ = static_cast<std::int64_t>(start);
+  comment_ = text(hd.link(5));
   metadata_blocks_.push_back(kIdBytes);
   std::set<std::uint64_t> seen;
   for (std::uint64_t at = hd.link(0); at != 0;) {

@@ -6,8 +6,8 @@
 // logger did not finalize, "UnFinMF "; the version text at byte 8; the unfinalized flags at
 // byte 60), then blocks, each "##XX", 4 reserved bytes, its length and its link count (64 bits
 // each), its links (64-bit file offsets, 0 = none) and its data. Read: ##HD (start time in ns,
-// time flags), the ##DG chain (record id size), each DG's ##CG chain (record id, cycle count,
-// flags: bit 0 = VLSD group, data bytes, invalidation bytes), each CG's ##CN tree (channel
+// time flags, comment), the ##DG chain (record id size), each DG's ##CG chain (record id, cycle
+// count, flags: bit 0 = VLSD group, data bytes, invalidation bytes), each CG's ##CN tree (channel
 // type, sync type, data type, bit and byte offset, bit count; composition children are listed
 // after their parent), ##CC conversions (identity, linear, rational, value-to-value with and
 // without interpolation, value-range-to-value, value-to-text, value-range-to-text), ##TX and
@@ -160,6 +160,8 @@ class Mdf4File {
   std::uint16_t unfinalized_flags() const { return unfinalized_flags_; }
   /// The measurement start (##HD), ns since 1970 (UTC unless the file says local time).
   std::int64_t start_ns() const { return start_ns_; }
+  /// The file's comment (##HD): an ##TX's text or an ##MD's <TX> element; "" when none.
+  const std::string& comment() const { return comment_; }
   std::uint64_t file_size() const { return bytes_.size(); }
   const std::vector<Mdf4DataGroup>& data_groups() const { return groups_; }
   /// What was recovered or dropped while reading (unfinalized files); grows as data is read.
@@ -223,6 +225,7 @@ class Mdf4File {
   bool unfinalized_ = false;
   std::uint16_t unfinalized_flags_ = 0;
   std::int64_t start_ns_ = 0;
+  std::string comment_;
   std::vector<Mdf4DataGroup> groups_;
   std::vector<std::uint64_t> metadata_blocks_;  // sorted offsets of the blocks parsed
   mutable std::vector<std::string> notes_;
