@@ -33,7 +33,7 @@ dds::Reply reply_to(const dds::Request& request, dds::ReplyStatus status, std::s
 // start and end are logged with the time taken, so that an operator sees what a worker is doing.
 bool computes(const std::string& kind) {
   for (const char* k :
-       {"residual", "add-effect", "trace", "consistency", "iv", "simex", "reprocess"})
+       {"residual", "add-effect", "trace", "consistency", "iv", "simex", "reprocess", "export"})
     if (kind == k) return true;
   return false;
 }

@@ -21,6 +21,7 @@
 #include "dynid/residual/model_fit.hpp"
 #include "dynid/residual/publication.hpp"
 #include "dynid/residual/trace.hpp"
+#include "dynid/server/export_request.hpp"
 
 namespace dynid::server {
 namespace {
@@ -157,6 +158,7 @@ std::vector<bool> simex_rows_where_least_squares_stands(
 
 ResidualReply residual_reply(const ingest::RunAnnouncement& announcement,
                              const std::vector<ingest::Chunk>& chunks, const ResidualRequest& request) {
+  if (request.kind == "export") return export_reply(announcement, chunks, request);
   if (request.format != "text" && request.format != "html" && request.format != "json")
     throw InputError("residual report: format '" + request.format + "' (text, json or html)");
   if (request.rounds < 0 || request.rounds > 10)

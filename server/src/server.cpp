@@ -224,11 +224,16 @@ dds::Reply Server::Impl::execute(const ParsedRequest& r, RunService& service) {
                      r.json());
   } else if (r.kind == "base") {
     payload = service.base_report(vehicle, r.required("run"), r.required("model"), r.json());
-  } else if (r.kind == "residual" || r.kind == "add-effect" || r.kind == "trace" || r.kind == "consistency" ||
-             r.kind == "iv" || r.kind == "simex") {
-    ResidualRequest request{r.kind == "consistency" ? "" : r.required("model"), std::nullopt, split_list(r.optional("candidates").value_or("")),
-                            r.kind == "add-effect" ? r.required("effect") : "", r.optional("format").value_or("text"),
-                            r.kind, parse_references(r.all("reference")), parse_rounds(r.optional("rounds"))};
+  } else if (r.kind == "residual" || r.kind == "add-effect" || r.kind == "trace" ||
+             r.kind == "consistency" || r.kind == "iv" || r.kind == "simex" || r.kind == "export") {
+    ResidualRequest request{r.optional("model").value_or(""),
+                            std::nullopt,
+                            split_list(r.optional("candidates").value_or("")),
+                            r.kind == "add-effect" ? r.required("effect") : "",
+                            r.optional("format").value_or("text"),
+                            r.kind,
+                            parse_references(r.all("reference")),
+                            parse_rounds(r.optional("rounds"))};
     request.series = parse_series(r.optional("series"));
     if (const auto effects = r.optional("effects"))  // "none": the model with no effect declared
       request.effects = *effects == "none" ? std::vector<std::string>{} : split_list(*effects);
