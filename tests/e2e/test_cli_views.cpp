@@ -1,16 +1,25 @@
-// What the dynid CLI prints for people and tools, without DDS (issue 16, items 1, 4 and 6): the compact
-// view of `dynid watch --model` (how a value moved, the in-place redraw, JSON lines) and
+// What the dynid CLI prints for people and tools, without DDS (issue 16, items 1, 4 and 6): the
+// compact view of `dynid watch --model` (how a value moved, the in-place redraw, JSON lines) and
 // `dynid status` as text, the estimate table of a model the run does not excite, and the
-// excitation report (what a run identifies, and the manoeuvres that would bring the rest).
+// excitation report (what a run identifies, and the manoeuvres that would bring the rest); and
+// what `dynid export` writes (issue 38, item 5): the server's MDF4 file read back by the
+// product's reader, and the CSV table made from it.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
 
+#include "dynid/can/mdf4.hpp"
+#include "dynid/cli/export_file.hpp"
 #include "dynid/cli/shard_replies.hpp"
 #include "dynid/cli/watch_view.hpp"
 #include "dynid/report/estimate_report.hpp"
 #include "dynid/report/excitation_report.hpp"
+#include "dynid/report/mdf4_writer.hpp"
 
 namespace dynid::test {
 namespace {
@@ -183,6 +192,104 @@ TEST(ExcitationReport, SaysSoWhenEveryParameterIsIdentified) {
   const std::string text = report::format_excitation_text(r);
   EXPECT_NE(text.find("identifies 2 of 2: mass, SCx"), std::string::npos) << text;
   EXPECT_NE(text.find("Every parameter this run can excite is identified."), std::string::npos) << text;
+}
+
+// Two tables on one grid, as an export has them: a channel both hold, times where only one has a
+// row, a value without a unit, a NaN, and values that need all 17 digits.
+report::Mdf4Document two_tables() {
+  report::Mdf4Document d;
+  d.start_ns = 1700000000123456789;
+  d.comment = "dynid export of run car/r1: models a, b; not exported: c: <no row>";
+  d.tables.push_back({"a.force",
+                      "a with no effect",
+                      {0.08, 0.16, 0.24},
+                      {{"vx", "m/s", "preprocessed", {10.0, 10.1, 1.0 / 3.0}},
+                       {"a.force.residual", "N", "", {0.1, -0.2, std::nan("")}}}});
+  d.tables.push_back(
+      {"b.yaw",
+       "",
+       {0.16, 0.32},
+       {{"vx", "m/s", "", {10.1, 10.2}}, {"gain", "", "dimensionless", {2.0 / 7.0, -1e-300}}}});
+  return d;
+}
+
+can::Mdf4File read_back(const std::string& bytes) {
+  return can::Mdf4File(std::vector<std::uint8_t>(bytes.begin(), bytes.end()), "export");
+}
+
+TEST(Export, TheWrittenFileReadsBackThroughTheProductsReader) {
+  const report::Mdf4Document d = two_tables();
+  const can::Mdf4File file = read_back(report::write_mdf4(d));
+  EXPECT_EQ(file.version(), "4.10");
+  EXPECT_FALSE(file.unfinalized());
+  EXPECT_EQ(file.start_ns(), d.start_ns);
+  EXPECT_EQ(file.comment(), d.comment);
+  ASSERT_EQ(file.data_groups().size(), d.tables.size());
+  for (std::size_t t = 0; t < d.tables.size(); ++t) {
+    const report::Mdf4Table& table = d.tables[t];
+    ASSERT_EQ(file.data_groups()[t].groups.size(), 1U);
+    const can::Mdf4ChannelGroup& group = file.data_groups()[t].groups[0];
+    EXPECT_EQ(group.name, table.name);
+    EXPECT_EQ(group.cycle_count, table.time_s.size());
+    ASSERT_NE(group.master(), nullptr);
+    EXPECT_EQ(group.master()->name, "time");
+    EXPECT_EQ(group.master()->unit, "s");
+    std::vector<std::string> names;
+    for (const report::Mdf4Column& column : table.columns) {
+      ASSERT_NE(group.find(column.name), nullptr) << column.name;
+      EXPECT_EQ(group.find(column.name)->unit, column.unit);
+      names.push_back(column.name);
+    }
+    const can::Mdf4Signals signals = file.read_signals(t, 0, names);
+    EXPECT_EQ(signals.time, table.time_s);
+    for (std::size_t c = 0; c < names.size(); ++c)
+      for (std::size_t k = 0; k < table.time_s.size(); ++k) {
+        const double written = table.columns[c].values[k], read = signals.values[c][k];
+        if (std::isnan(written))
+          EXPECT_TRUE(std::isnan(read));
+        else
+          EXPECT_EQ(read, written) << names[c] << " at " << k;  // bit for bit: float64 stored
+      }
+  }
+}
+
+TEST(Export, TheCsvTableJoinsTheGroupsOnTheirTimes) {
+  const can::Mdf4File file = read_back(report::write_mdf4(two_tables()));
+  std::istringstream csv(cli::export_csv(file));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "time [s],vx [m/s],a.force.residual [N],gain");
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cells;
+    std::istringstream fields(line + ",");
+    for (std::string cell; std::getline(fields, cell, ',');) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  ASSERT_EQ(rows.size(), 4U);  // 0.08, 0.16 (both tables), 0.24, 0.32
+  const auto value = [](const std::string& cell) { return std::strtod(cell.c_str(), nullptr); };
+  EXPECT_EQ(value(rows[0][0]), 0.08);
+  EXPECT_EQ(rows[0][3], "");  // b has no row at 0.08
+  EXPECT_EQ(value(rows[1][1]), 10.1);
+  EXPECT_EQ(value(rows[1][2]), -0.2);
+  EXPECT_EQ(value(rows[1][3]), 2.0 / 7.0);  // the shortest text that reads back to the double
+  EXPECT_EQ(value(rows[2][1]), 1.0 / 3.0);
+  EXPECT_TRUE(std::isnan(value(rows[2][2])));
+  EXPECT_EQ(rows[3][2], "");  // a has no row at 0.32
+  EXPECT_EQ(value(rows[3][3]), -1e-300);
+  const std::string summary = cli::export_summary(file);
+  EXPECT_NE(summary.find("a.force: 3 rows from 0.08 to 0.24 s, 2 columns"), std::string::npos)
+      << summary;
+  EXPECT_NE(summary.find("not exported: c: <no row>"), std::string::npos) << summary;
+}
+
+TEST(Export, AColumnOfTheWrongLengthOrARepeatedNameIsTheCallersBug) {
+  report::Mdf4Document d = two_tables();
+  d.tables[1].columns[0].values.pop_back();
+  EXPECT_THROW(report::write_mdf4(d), std::invalid_argument);
+  d = two_tables();
+  d.tables[0].columns[1].name = "vx";
+  EXPECT_THROW(report::write_mdf4(d), std::invalid_argument);
 }
 
 }  // namespace

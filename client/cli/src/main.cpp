@@ -24,6 +24,7 @@
 #include <dynid/options/option_checks.hpp>
 
 #include "dynid/cli/catalogue_view.hpp"
+#include "dynid/cli/export_file.hpp"
 #include "dynid/cli/request_client.hpp"
 #include "dynid/cli/shard_replies.hpp"
 #include "dynid/cli/watch_view.hpp"
@@ -145,6 +146,30 @@ int report_request(const Common& c, const std::string& kind, const std::vector<R
     return 2;
   }
   std::cout << "report written to " << html_file << " (" << reply.payload.size() << " bytes)\n";
+  return 0;
+}
+
+// An export (server/export_request.hpp): the server's MDF4 file, read back with the product's
+// reader (a file that does not read is not written), then written as it came or as one CSV table.
+int export_request(const Common& c, const std::vector<RequestArgument>& arguments,
+                   const std::string& format, const std::string& output) {
+  check_against_protocol("export", arguments);
+  dynid::dds::Participant participant(participant_options(c));
+  dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
+  const dynid::dds::Reply reply = client.call("export", arguments, timeout_of(c));
+  if (reply.status != dynid::dds::ReplyStatus::kOk) return print("export", reply);
+  const dynid::can::Mdf4File file(
+      std::vector<std::uint8_t>(reply.payload.begin(), reply.payload.end()), "the server's export");
+  const std::string bytes = format == "csv" ? dynid::cli::export_csv(file) : reply.payload;
+  std::ofstream out(output, std::ios::binary);
+  out << bytes;
+  if (!out.flush()) {
+    std::cerr << "dynid export: cannot write " << output << "\n";
+    return 2;
+  }
+  std::cout << "export written to " << output << " (" << bytes.size() << " bytes, "
+            << (format == "csv" ? "CSV" : "MDF " + file.version()) << ")\n"
+            << dynid::cli::export_summary(file);
   return 0;
 }
 
@@ -337,6 +362,22 @@ int main(int argc, char** argv) {
   auto* simex_cmd = estimator_command(
       "simex", "least squares corrected for the measured sensor noise (SIMEX), beside least squares, and "
                "which one the server publishes (docs/ACCURACY.md)");
+  std::string export_format = "mdf4", output;
+  auto* export_cmd = app.add_subcommand(
+      "export",
+      "a run's channels, and each model's measured side, fitted values and residual on its "
+      "rows, as an MDF4 file (asammdf, MATLAB, CANape) or one CSV table");
+  vehicle_option(export_cmd, vehicle);
+  run_option(export_cmd, run, true);
+  model_option(export_cmd, model, false);
+  export_cmd->add_option(
+      "--effects", effects,
+      "with --model: the model's declared effects (default: the run's; none: no effect)");
+  export_cmd->add_option("--format", export_format, "mdf4 (default) or csv")
+      ->check(CLI::IsMember({"mdf4", "csv"}));
+  export_cmd->add_option("--output", output, "the file to write")
+      ->required()
+      ->check(dynid::input::output_file("export"));
   auto* base_cmd = app.add_subcommand("base", "base-parameter report of a run's model");
   vehicle_option(base_cmd, vehicle);
   run_option(base_cmd, run, true);
@@ -443,6 +484,15 @@ int main(int argc, char** argv) {
     if (*simex_cmd) {
       if (timeout->count() == 0) c.timeout_s = 120.0;  // the run replayed, refitted 2 x lambdas x draws times
       return request(c, "simex", args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects}}));
+    }
+    if (*export_cmd) {
+      if (c.json) throw dynid::InputError("export: --json: the export is a file, its summary text");
+      if (!effects.empty() && model.empty())
+        throw dynid::InputError("export: --effects needs --model");
+      if (timeout->count() == 0) c.timeout_s = 120.0;  // the run replayed, every model fitted
+      return export_request(
+          c, args({{"vehicle", vehicle}, {"run", run}, {"model", model}, {"effects", effects}}),
+          export_format, output);
     }
     if (*base_cmd) return request(c, "base", args({{"vehicle", vehicle}, {"run", run}, {"model", model}}));
     if (*close_cmd) return request(c, "close", args({{"vehicle", vehicle}, {"run", run}}));

@@ -1,0 +1,25 @@
+#pragma once
+// What `dynid export` writes and prints. The server answers an export with one ASAM MDF 4.10 file
+// (server/export_request.hpp): one channel group per model and equation group, on the rows the
+// model is fitted on. The CLI reads it back with the product's MDF4 reader (can/mdf4.hpp) before
+// saying it wrote it, and writes it as it came (--format mdf4) or as one CSV table (csv).
+//
+// export_csv(): one table for tools that want one (MATLAB's readtable, pandas): a "time [s]"
+// column over the union of every group's row times (the models share the run's decimation grid,
+// so equal times are one row), then every group's columns, a channel several groups hold once
+// (the groups read one preprocessed run, so they agree on it); the header names each column
+// "name [unit]" ("name" when it has no unit); a cell a group has no row for is empty; values are
+// written in the shortest form that reads back to the same double.
+//
+// export_summary(): per group its name, rows, time span and column count, and the file's
+// comment (which models it holds and which it left out, and why), lines within 100 columns.
+#include <string>
+
+#include <dynid/can/mdf4.hpp>
+
+namespace dynid::cli {
+
+std::string export_csv(const can::Mdf4File& file);
+std::string export_summary(const can::Mdf4File& file);
+
+}  // namespace dynid::cli
