@@ -179,31 +179,39 @@ TEST(Mdf4, EveryRawCanedgeFileReplaysWithoutErrors) {
   EXPECT_GE(unfinalized, 1U);
 }
 
-// Must-show 1: the raw split decoded with the GNSS module's DBC by the product's decoder gives
-// every value asammdf 7.0 wrote to decoded/ (one channel group per message, one channel per
-// signal), read back through Mdf4File::read_signals, at the same times.
-TEST(Mdf4, DecodingTheRawSplitReproducesAsammdfsDecodedFile) {
-  DYNID_REQUIRE_DIR(mdf4_dir());
+// The raw split decoded with the GNSS module's DBC by the product's decoder: per message id, the
+// frames' times (seconds from `start_s`) and per signal name its decoded values.
+struct DecodedMessages {
+  std::vector<double> time;
+  std::map<std::string, std::vector<double>> values;
+};
+
+std::map<std::uint32_t, DecodedMessages> decode_split1(double start_s) {
   const Database db = parse_dbc_file(mdf4_dir() / "dbc" / "canmod-gps.dbc");
   Decoder decoder(db);
   Mdf4BusReader raw(raw_file(kSplit1));
-  // per message id: times (seconds from the start) and per signal name the decoded values
-  struct Decoded {
-    std::vector<double> time;
-    std::map<std::string, std::vector<double>> values;
-  };
-  std::map<std::uint32_t, Decoded> by_id;
-  const Mdf4File decoded(mdf4_dir() / "decoded" / "3BA199E2_00000164_00000001-60FE3F04.mf4");
-  const double start = static_cast<double>(decoded.start_ns()) / 1e9;
+  std::map<std::uint32_t, DecodedMessages> by_id;
   std::vector<DecodedSignal> out;
   Frame f;
   while (raw.next(f)) {
     if (f.interface_name() != "can1" || f.extended) continue;  // the module is on bus channel 2
     if (decoder.decode(f, out).status != DecodeStatus::Ok) continue;
-    Decoded& d = by_id[f.id];
-    d.time.push_back(f.timestamp - start);
-    for (const auto& s : out) d.values[s.signal->name].push_back(s.value);
+    DecodedMessages& d = by_id[f.id];
+    d.time.push_back(f.timestamp - start_s);
+    for (const auto& signal : out) d.values[signal.signal->name].push_back(signal.value);
   }
+  return by_id;
+}
+
+const char* const kDecodedSplit1 = "3BA199E2_00000164_00000001-60FE3F04";
+
+// Must-show 1: the raw split decoded with the GNSS module's DBC by the product's decoder gives
+// every value asammdf 7.0 wrote to decoded/ (one channel group per message, one channel per
+// signal), read back through Mdf4File::read_signals, at the same times.
+TEST(Mdf4, DecodingTheRawSplitReproducesAsammdfsDecodedFile) {
+  DYNID_REQUIRE_DIR(mdf4_dir());
+  const Mdf4File decoded(mdf4_dir() / "decoded" / (std::string(kDecodedSplit1) + ".mf4"));
+  auto by_id = decode_split1(static_cast<double>(decoded.start_ns()) / 1e9);
   std::size_t compared = 0, groups = 0;
   double largest = 0, largest_time = 0;
   std::string where;
@@ -212,7 +220,7 @@ TEST(Mdf4, DecodingTheRawSplitReproducesAsammdfsDecodedFile) {
     unsigned id = 0;
     ASSERT_EQ(std::sscanf(g.name.c_str(), "CAN2 message ID=0x%x", &id), 1) << g.name;
     ASSERT_TRUE(by_id.count(id)) << "no decoded frames of id " << id;
-    const Decoded& mine = by_id[id];
+    const DecodedMessages& mine = by_id[id];
     std::vector<std::string> names;
     for (const auto& c : g.channels)
       if (!c.is_master()) names.push_back(c.name);
@@ -253,6 +261,82 @@ TEST(Mdf4, DecodingTheRawSplitReproducesAsammdfsDecodedFile) {
             << " messages with asammdf's decoded file: largest "
             << "difference " << largest << (where.empty() ? "" : " (" + where + ")")
             << ", largest time difference " << largest_time << " s\n";
+}
+
+// Must-show 1, the .mat: the vendor's script exported asammdf's decoded values to MATLAB on a
+// 1 s raster (its "timestamps"): integer signals as the previous sample, floats interpolated
+// linearly (numpy's interp: the end values held outside the data). The product's decoded values,
+// at asammdf's times, resampled by the same rules, give every value of the .mat: integers exactly,
+// floats to their rounding. The .mat is read by scipy (mat_dump.py): the product has no .mat
+// reader.
+TEST(Mdf4, DecodingTheRawSplitReproducesTheVendorsMatFile) {
+  DYNID_REQUIRE_DIR(mdf4_dir());
+  const Mdf4File decoded(mdf4_dir() / "decoded" / (std::string(kDecodedSplit1) + ".mf4"));
+  const auto by_id = decode_split1(static_cast<double>(decoded.start_ns()) / 1e9);
+  // Per signal name: asammdf's times of its message and the product's values.
+  std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> series;
+  for (std::size_t dg = 0; dg < decoded.data_groups().size(); ++dg) {
+    const Mdf4ChannelGroup& g = decoded.data_groups()[dg].groups.at(0);
+    unsigned id = 0;
+    ASSERT_EQ(std::sscanf(g.name.c_str(), "CAN2 message ID=0x%x", &id), 1) << g.name;
+    const Mdf4Signals times = decoded.read_signals(dg, 0, {});
+    for (const auto& [name, values] : by_id.at(id).values) {
+      ASSERT_EQ(values.size(), times.time.size()) << name;
+      ASSERT_TRUE(series.emplace(name, std::make_pair(times.time, values)).second)
+          << name << " twice";
+    }
+  }
+  int status = -1;
+  const std::string dump = test::run_command(
+      std::string(DYNID_SYSTEM_PYTHON) + " " + DYNID_CAN_TEST_DIR + "/mat_dump.py " +
+          (mdf4_dir() / "decoded" / (std::string(kDecodedSplit1) + ".mat")).string(),
+      status);
+  ASSERT_EQ(status, 0) << dump;
+  std::map<std::string, std::pair<std::string, std::vector<double>>> mat;
+  std::istringstream lines(dump);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream fields(line);
+    std::string name, kind;
+    std::size_t count = 0;
+    fields >> name >> kind >> count;
+    std::vector<double> values(count);
+    for (double& v : values) fields >> v;
+    ASSERT_TRUE(fields) << "mat_dump: " << line.substr(0, 80);
+    mat[name] = {kind, values};
+  }
+  ASSERT_TRUE(mat.count("timestamps"));
+  const std::vector<double>& raster = mat["timestamps"].second;
+  std::size_t compared = 0;
+  double largest = 0;
+  for (const auto& [name, entry] : mat) {
+    if (name == "timestamps") continue;
+    ASSERT_TRUE(series.count(name)) << "the .mat's " << name << " is no decoded signal";
+    const auto& [t, v] = series.at(name);
+    for (std::size_t k = 0; k < raster.size(); ++k) {
+      const double x = raster[k];
+      const auto after =
+          static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin());
+      double expected = 0;
+      if (entry.first == "int") {
+        expected = v[after == 0 ? 0 : after - 1];
+      } else if (after == 0 || after == t.size()) {
+        expected = after == 0 ? v.front() : v.back();
+      } else {
+        const std::size_t j = after - 1;
+        expected = (v[j + 1] - v[j]) / (t[j + 1] - t[j]) * (x - t[j]) + v[j];
+      }
+      const double diff = std::fabs(expected - entry.second[k]);
+      const double allowed =
+          entry.first == "int" ? 0.0 : 1e-12 * std::max(1.0, std::fabs(entry.second[k]));
+      ASSERT_LE(diff, allowed) << name << " at " << x << " s: " << expected << " vs the .mat's "
+                               << entry.second[k];
+      largest = std::max(largest, diff);
+      ++compared;
+    }
+  }
+  EXPECT_EQ(mat.size(), 40U);  // 39 signals and the raster
+  std::cout << "compared " << compared << " values of " << mat.size() - 1
+            << " signals with the vendor's .mat: largest difference " << largest << "\n";
 }
 
 // The frames of an MDF4 bus log written as candump text read back as the same frames.

@@ -46,7 +46,8 @@ struct ResidualRequest {
   std::vector<std::string> candidates;              ///< empty: every candidate
   std::string effect;                               ///< add-effect only
   std::string format = "text";                      ///< text | json | html
-  std::string kind = "residual";                    ///< residual | add-effect | trace | consistency | iv
+  /// residual | add-effect | trace | consistency | iv | simex | export (export_request.hpp)
+  std::string kind = "residual";
   std::map<std::string, double> reference;          ///< add-effect, trace, consistency
   int rounds = 4;                                   ///< trace only
   bool series = false;  ///< json of add-effect and trace: the added effect's series row by row
