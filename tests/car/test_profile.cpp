@@ -210,6 +210,27 @@ TEST(CarProfile, AChannelIsInterpolatedLinearlyUnlessItsMappingSaysCubic) {
   EXPECT_EQ(cubic.channels[1].interpolation, Interpolation::kLinear);
 }
 
+// Issue 36, item 3: a channel given as a constant in its SI unit: its value only, within the
+// channel's physical range.
+TEST(CarProfile, AChannelGivenAsAConstantHasItsValueOnly) {
+  const std::string with = kGood + "[[channels]]\nname = \"gear_ratio\"\nconstant = 3.5\n";
+  const VehicleProfile p = parse_vehicle_profile(with, profile_path("broken.toml"));
+  const ChannelMapping& gear = mapping(p, "gear_ratio");
+  ASSERT_TRUE(gear.constant.has_value());
+  EXPECT_EQ(*gear.constant, 3.5);
+  EXPECT_EQ(gear.unit, "-");
+  EXPECT_TRUE(gear.inputs.empty());
+  EXPECT_FALSE(mapping(p, "vx").constant.has_value());
+  expect_error(replace(with, "constant = 3.5", "constant = 3.5\nmessage = \"SAS_Steering\""),
+               ":30:", "channels[2].message", "unknown key");
+  expect_error(replace(with, "constant = 3.5", "constant = \"3.5\""),
+               ":29:", "channels[2].constant", "expected a number");
+  expect_error(replace(kGood + "[[channels]]\nname = \"vy\"\nconstant = 3.5\n", "constant = 3.5",
+                       "constant = 500"),
+               ":29:", "channels[2].constant",
+               "channel 'vy' cannot be 500 m/s (its physical range is -120 to 120 m/s)");
+}
+
 TEST(CarProfile, ConstantsAndModels) {
   expect_error(replace(kGood, "divide_by = \"steering_ratio\"", "divide_by = \"ratio\""), ":26:",
                "channels[1].divide_by", "no constant 'ratio' in [constants]");

@@ -91,6 +91,44 @@ std::size_t column(const VehicleProfile& p, const std::string& channel) {
   throw std::runtime_error("no channel " + channel);
 }
 
+// Issue 36, item 3: a channel the profile gives as a constant (a manual car's gear ratio on a
+// run in one gear) rides on every frame of the bus: the run's chunks are those of the profile
+// without it, row for row and value for value, with one more column holding the constant in
+// every valid row (no gap of its own, no message or signal needed).
+TEST(CarRav4Replay, AConstantChannelOfTheProfileRidesOnEveryFrame) {
+  DYNID_REQUIRE_RAV4_DATA();
+  const Replayed base = replay_rav4({});
+  std::ifstream in(test::profile_path("rav4.toml"));
+  std::stringstream text;
+  text << in.rdbuf() << "\n[[channels]]\nname = \"gear_ratio\"\nconstant = 3.5\n";
+  const VehicleProfile profile = parse_vehicle_profile(text.str(), test::profile_path("rav4.toml"));
+  const std::size_t gear = column(profile, "gear_ratio");
+  EXPECT_EQ(*profile.channels[gear].constant, 3.5);
+  std::vector<ingest::Chunk> chunks;
+  CarPipeline pipeline(profile, "seg40",
+                       [&](ingest::Chunk&& c) { chunks.push_back(std::move(c)); });
+  CandumpSource source(test::rav4_log());
+  replay(source, pipeline);
+  ASSERT_EQ(chunks.size(), base.chunks.size());
+  std::size_t valid = 0;
+  for (std::size_t k = 0; k < chunks.size(); ++k) {
+    const ingest::Chunk& a = base.chunks[k];
+    const ingest::Chunk& b = chunks[k];
+    ASSERT_EQ(b.first_sample_index, a.first_sample_index) << "chunk " << k;
+    ASSERT_EQ(b.valid, a.valid) << "chunk " << k;
+    for (std::size_t c = 0; c < base.profile.channels.size(); ++c) {
+      const auto at = static_cast<Eigen::Index>(column(profile, base.profile.channels[c].channel));
+      ASSERT_EQ(b.samples.col(at), a.samples.col(static_cast<Eigen::Index>(c))) << "chunk " << k;
+    }
+    for (std::size_t row = 0; row < b.valid.size(); ++row)
+      if (b.valid[row] != 0) {
+        ASSERT_EQ(b.samples(static_cast<Eigen::Index>(row), static_cast<Eigen::Index>(gear)), 3.5);
+        ++valid;
+      }
+  }
+  EXPECT_GT(valid, 1000U);
+}
+
 TEST(CarRav4Replay, EveryFrameIsAccountedForAndChunksAreContiguous) {
   DYNID_REQUIRE_RAV4_DATA();
   const Replayed r = replay_rav4({});

@@ -98,7 +98,9 @@ std::vector<std::string> CarPipeline::missing_report() const {
   for (const auto& [missing, c] : order) {
     const ChannelMapping& m = profile_.channels[c];
     std::string from;
-    if (m.source && *m.source < profile_.sources.size()) {
+    if (m.constant) {
+      from = "the profile's constant, which comes with every mapped frame: no channel had one";
+    } else if (m.source && *m.source < profile_.sources.size()) {
       from = "auxiliary source '" + profile_.sources[*m.source].name + "'";
     } else {
       from = "message '" + m.message + "', signal";

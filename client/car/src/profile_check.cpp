@@ -18,6 +18,7 @@ std::string figure(const char* format, double v) {
 
 std::string source_of(const VehicleProfile& profile, const ChannelMapping& c) {
   if (c.source) return "source '" + profile.sources.at(*c.source).name + "'";
+  if (c.constant) return "constant " + figure("%g", *c.constant) + " " + c.unit;
   std::string signals;
   for (const SignalInput& in : c.inputs)
     signals += (signals.empty() ? c.message + "." : "+") + in.signal;

@@ -6,8 +6,13 @@
 namespace dynid::car {
 
 SignalMapper::SignalMapper(const VehicleProfile& profile) : profile_(profile), decoder_(*profile.dbc) {
-  for (std::size_t c = 0; c < profile_.channels.size(); ++c)
-    if (!profile_.channels[c].source) channels_of_[profile_.channels[c].dbc_message].push_back(c);  // bus channels
+  for (std::size_t c = 0; c < profile_.channels.size(); ++c) {
+    if (profile_.channels[c].source) continue;  // an auxiliary source's
+    if (profile_.channels[c].constant)
+      constants_.push_back(c);
+    else
+      channels_of_[profile_.channels[c].dbc_message].push_back(c);  // bus channels
+  }
 }
 
 FrameOutcome SignalMapper::map(const can::Frame& frame, std::vector<ChannelSample>& out) {
@@ -45,6 +50,8 @@ FrameOutcome SignalMapper::map(const can::Frame& frame, std::vector<ChannelSampl
     }
     out.push_back({c, frame.timestamp, v});
   }
+  for (std::size_t c : constants_)
+    out.push_back({c, frame.timestamp, *profile_.channels[c].constant});
   return FrameOutcome::Mapped;
 }
 

@@ -307,8 +307,43 @@ const can::Message* dbc_message(const Reader& r, const VehicleProfile& p, const 
   return found[0];
 }
 
+// A channel's catalogue name and its SI unit.
+ChannelMapping named_channel(const Reader& r, const toml::table& t, const std::string& key) {
+  ChannelMapping m;
+  m.channel = r.string(t, "name", key + ".name");
+  const auto unit = model::channel_unit(m.channel);
+  if (!unit)
+    r.fail(key + ".name", "unknown channel '" + m.channel + "' (see docs/CHANNELS.md)",
+           t.get("name"));
+  m.unit = *unit;
+  return m;
+}
+
+// `constant = <value>` in the channel's SI unit, instead of a message and signals: the value must
+// be one the channel can physically take (the channel health's range, docs/CHANNELS.md).
+ChannelMapping constant_channel(const Reader& r, const toml::table& t, const std::string& key) {
+  r.only_keys(t, {"name", "constant"}, key + ".");
+  ChannelMapping m = named_channel(r, t, key);
+  const double value = r.number(*t.get("constant"), key + ".constant");
+  if (const auto physics = model::channel_physics(m.channel);
+      physics && (value < physics->lower || value > physics->upper)) {
+    std::ostringstream reason;
+    reason << "channel '" << m.channel << "' cannot be " << value << " " << m.unit
+           << " (its physical range is " << physics->lower << " to " << physics->upper << " "
+           << m.unit << ")";
+    r.fail(key + ".constant", reason.str(), t.get("constant"));
+  }
+  m.message = "constant";
+  m.constant = value;
+  // Its samples come with the frames of every message, irregular as the bus is: no gap rule of
+  // its own, so a row's validity is that of the measured channels.
+  m.max_gap = kMaxSeconds;
+  return m;
+}
+
 ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml::table& t,
                             const std::string& key, bool in_source = false) {
+  if (!in_source && t.contains("constant")) return constant_channel(r, t, key);
   if (in_source)  // a channel of a second bus (type = "can" source)
     r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
                     "scale", "divide_by", "sign", "max_gap", "interpolation", "replaces_bus"},
@@ -317,11 +352,7 @@ ChannelMapping read_channel(const Reader& r, const VehicleProfile& p, const toml
     r.only_keys(t, {"name", "message", "signal", "signals", "combine", "dbc_unit", "factor", "offset",
                     "scale", "divide_by", "sign", "max_gap", "interpolation"},
                 key + ".");
-  ChannelMapping m;
-  m.channel = r.string(t, "name", key + ".name");
-  const auto unit = model::channel_unit(m.channel);
-  if (!unit) r.fail(key + ".name", "unknown channel '" + m.channel + "' (see docs/CHANNELS.md)", t.get("name"));
-  m.unit = *unit;
+  ChannelMapping m = named_channel(r, t, key);
   m.message = r.string(t, "message", key + ".message");
   m.dbc_message = dbc_message(r, p, m.message, key, t);
   for (const auto& name : signal_names(r, t, key)) {
@@ -704,7 +735,7 @@ std::set<std::string> constants_read(const std::string& model) {
 std::string unread_reason(const std::string& name, const std::string& readers) {
   if (model::channel_unit(name))
     return "'" + name + "' is a channel, not a constant: constants never stand in for a channel " +
-           "(map it under [channels])";
+           "(map it under [[channels]], or give it there as `constant = <value>`)";
   return "read by " + readers + ": it has no effect (a misspelling? `dynid models` lists what " +
          "each model reads)";
 }

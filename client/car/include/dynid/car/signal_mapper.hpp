@@ -10,7 +10,9 @@
 // its channel in dropped(). A frame whose timestamp is not usable_time() (negative, or
 // past kMaxTimestamp) is counted as bad_time and produces nothing: on such a clock a grid period
 // is below the resolution of a double (at 1e299 s, t + 0.01 == t), so the resampler could not
-// tell one row from the next. The profile must outlive the mapper.
+// tell one row from the next. A constant channel of the profile (ChannelMapping::constant) gets a
+// sample at every frame that carries a channel of the profile, so it moves neither the run's
+// first sample nor its grid. The profile must outlive the mapper.
 #include <cstddef>
 #include <cstdint>
 #include <unordered_map>
@@ -63,6 +65,7 @@ class SignalMapper {
   const VehicleProfile& profile_;
   can::Decoder decoder_;
   std::unordered_map<const can::Message*, std::vector<std::size_t>> channels_of_;
+  std::vector<std::size_t> constants_;  // the profile's constant channels: a sample at every frame
   std::vector<can::DecodedSignal> decoded_;
   std::vector<double> physical_;
   MapStats stats_;

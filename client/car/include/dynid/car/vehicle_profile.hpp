@@ -68,6 +68,12 @@ struct ChannelMapping {
   /// VehicleProfile::sources and into its channels; the bus decoder never sees it.
   std::optional<std::size_t> source;
   std::size_t source_channel = 0;
+  /// Set for a channel the profile gives as one value in its SI unit (`constant = 3.5`: a gear
+  /// ratio of a run in one gear, a flat track's road_grade): no DBC message or signal, and every
+  /// frame that carries a channel of the profile carries the value too (signal_mapper.hpp), so
+  /// the channel is valid while the bus is alive; it has no gap rule of its own (max_gap is the
+  /// longest allowed), so a row's validity is that of the measured channels.
+  std::optional<double> constant;
 
   /// The channel value from the message's decoded physical values (indexed like
   /// can::Message::signals).
