@@ -311,6 +311,7 @@ Mdf4ChannelGroup Mdf4File::channel_group(const Block& cg) {
   Mdf4ChannelGroup g;
   g.offset = cg.offset;
   g.name = text(cg.link(2));
+  g.comment = text(cg.link(5));
   g.record_id = u64(cg.data);
   g.cycle_count = u64(cg.data + 8);
   g.flags = u16(cg.data + 16);
@@ -334,6 +335,7 @@ void Mdf4File::parse_channels(std::uint64_t first, Mdf4ChannelGroup& group, int 
     c.offset = at;
     c.name = text(cn.link(2));
     c.unit = text(cn.link(6));
+    c.comment = text(cn.link(7));
     c.type = cn.data[0];
     c.sync_type = cn.data[1];
     c.data_type = cn.data[2];

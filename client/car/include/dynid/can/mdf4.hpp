@@ -6,13 +6,14 @@
 // logger did not finalize, "UnFinMF "; the version text at byte 8; the unfinalized flags at
 // byte 60), then blocks, each "##XX", 4 reserved bytes, its length and its link count (64 bits
 // each), its links (64-bit file offsets, 0 = none) and its data. Read: ##HD (start time in ns,
-// time flags, comment), the ##DG chain (record id size), each DG's ##CG chain (record id, cycle
-// count, flags: bit 0 = VLSD group, data bytes, invalidation bytes), each CG's ##CN tree (channel
-// type, sync type, data type, bit and byte offset, bit count; composition children are listed
-// after their parent), ##CC conversions (identity, linear, rational, value-to-value with and
-// without interpolation, value-range-to-value, value-to-text, value-range-to-text), ##TX and
-// ##MD texts (an ##MD's <TX> element), and the data: ##DT, ##SD, ##DL chains and ##DZ (zlib
-// deflate, plain or transposed), VLSD values from an ##SD stream or a VLSD channel group.
+// time flags, comment), the ##DG chain (record id size), each DG's ##CG chain (name, comment,
+// record id, cycle count, flags: bit 0 = VLSD group, data bytes, invalidation bytes), each CG's
+// ##CN tree (name, unit, comment, channel type, sync type, data type, bit and byte offset, bit
+// count; composition children are listed after their parent), ##CC conversions (identity, linear,
+// rational, value-to-value with and without interpolation, value-range-to-value, value-to-text,
+// value-range-to-text), ##TX and ##MD texts (an ##MD's <TX> element), and the data: ##DT, ##SD,
+// ##DL chains and ##DZ (zlib deflate, plain or transposed), VLSD values from an ##SD stream or a
+// VLSD channel group.
 //
 // Unfinalized files (the identification "UnFinMF "): a logger that loses power leaves the cycle
 // counts and the length of the last data block unset. The last data block then runs to the next
@@ -89,6 +90,7 @@ struct Mdf4Channel {
   };
   std::string name;
   std::string unit;
+  std::string comment;       // "" when none
   std::uint64_t offset = 0;  // of the ##CN block
   std::uint8_t type = Fixed;
   std::uint8_t sync_type = 0;
@@ -102,7 +104,8 @@ struct Mdf4Channel {
 };
 
 struct Mdf4ChannelGroup {
-  std::string name;  // the acquisition name (e.g. "CAN_DataFrame"), "" when none
+  std::string name;     // the acquisition name (e.g. "CAN_DataFrame"), "" when none
+  std::string comment;  // "" when none
   std::uint64_t offset = 0;
   std::uint64_t record_id = 0;
   std::uint64_t cycle_count = 0;  // as stored (see the unfinalized note above)
