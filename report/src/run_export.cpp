@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "dynid/error.hpp"
 #include "dynid/residual/model_fit.hpp"
 
 namespace dynid::report {
@@ -79,6 +80,38 @@ std::vector<Mdf4Table> export_tables(const model::Model& model,
     tables.push_back(std::move(table));
   }
   return tables;
+}
+
+std::string export_comment(const std::string& run_name, const std::string& exported,
+                           const std::string& left_out) {
+  return "dynid export of run " + run_name +
+         "\ntimes: s from the run's start (the run carries no wall-clock time)\nmodels: " +
+         exported + (left_out.empty() ? "" : "\nnot exported: " + left_out);
+}
+
+std::vector<std::vector<Mdf4Table>> export_parts(std::vector<Mdf4Table> tables,
+                                                 std::size_t max_bytes,
+                                                 const std::string& comment) {
+  // A file's size is its header's plus each table's blocks, whatever else the file holds.
+  Mdf4Document document{0, comment, {}};
+  const std::size_t header = write_mdf4(document).size();
+  std::vector<std::vector<Mdf4Table>> parts;
+  std::size_t size = 0;
+  for (Mdf4Table& table : tables) {
+    document.tables = {table};
+    const std::size_t bytes = write_mdf4(document).size() - header;
+    if (header + bytes > max_bytes)
+      throw InputError(fmt::format("table {} alone is {:.1f} MiB, past a reply's {:.0f} MiB",
+                                   table.name, static_cast<double>(header + bytes) / (1 << 20),
+                                   static_cast<double>(max_bytes) / (1 << 20)));
+    if (parts.empty() || size + bytes > max_bytes) {
+      parts.emplace_back();
+      size = header;
+    }
+    parts.back().push_back(std::move(table));
+    size += bytes;
+  }
+  return parts;
 }
 
 }  // namespace dynid::report

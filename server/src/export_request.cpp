@@ -52,17 +52,15 @@ ResidualReply export_reply(const ingest::RunAnnouncement& announcement,
   }
   if (document.tables.empty())
     throw InputError("run " + run_name + ": no model can be exported (" + left_out + ")");
-  document.comment =
-      "dynid export of run " + run_name +
-      "\ntimes: s from the run's start (the run carries no wall-clock time)\nmodels: " + exported +
-      (left_out.empty() ? "" : "\nnot exported: " + left_out);
-  std::string bytes = report::write_mdf4(document);
-  if (bytes.size() > dynid_wire_kMaxPayload)
-    throw InputError(fmt::format("the export of {} is {:.1f} MiB, past a reply's {} MiB{}",
-                                 run_name, static_cast<double>(bytes.size()) / (1 << 20),
-                                 dynid_wire_kMaxPayload >> 20,
-                                 one ? "" : ": export one model at a time (--model)"));
-  return {std::move(bytes), "application/x-mdf4"};
+  document.comment = report::export_comment(run_name, exported, left_out);
+  auto parts =
+      report::export_parts(std::move(document.tables), dynid_wire_kMaxPayload, document.comment);
+  if (request.part < 1 || static_cast<std::size_t>(request.part) > parts.size())
+    throw InputError(fmt::format("the export of {} has {} part{}: no part {}", run_name,
+                                 parts.size(), parts.size() == 1 ? "" : "s", request.part));
+  document.tables = std::move(parts[static_cast<std::size_t>(request.part - 1)]);
+  return {report::write_mdf4(document),
+          fmt::format("application/x-mdf4; part={}/{}", request.part, parts.size())};
 }
 
 }  // namespace dynid::server

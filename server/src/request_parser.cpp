@@ -116,6 +116,14 @@ int parse_rounds(const std::optional<std::string>& text) {
   return static_cast<int>(*rounds);
 }
 
+int parse_part(const std::optional<std::string>& text) {
+  if (!text) return 1;
+  const std::optional<long long> part = input::parse_integer(*text);
+  if (!part || *part < 1 || *part > 1000000)
+    throw InputError("part '" + *text + "': an integer from 1");
+  return static_cast<int>(*part);
+}
+
 bool parse_series(const std::optional<std::string>& text) {
   if (!text) return false;
   if (*text != "yes")

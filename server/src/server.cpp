@@ -235,6 +235,7 @@ dds::Reply Server::Impl::execute(const ParsedRequest& r, RunService& service) {
                             parse_references(r.all("reference")),
                             parse_rounds(r.optional("rounds"))};
     request.series = parse_series(r.optional("series"));
+    request.part = parse_part(r.optional("part"));
     if (const auto effects = r.optional("effects"))  // "none": the model with no effect declared
       request.effects = *effects == "none" ? std::vector<std::string>{} : split_list(*effects);
     ResidualReply reply = service.residual(vehicle, r.required("run"), request);

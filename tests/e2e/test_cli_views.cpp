@@ -17,9 +17,11 @@
 #include "dynid/cli/export_file.hpp"
 #include "dynid/cli/shard_replies.hpp"
 #include "dynid/cli/watch_view.hpp"
+#include "dynid/error.hpp"
 #include "dynid/report/estimate_report.hpp"
 #include "dynid/report/excitation_report.hpp"
 #include "dynid/report/mdf4_writer.hpp"
+#include "dynid/report/run_export.hpp"
 
 namespace dynid::test {
 namespace {
@@ -290,6 +292,28 @@ TEST(Export, AColumnOfTheWrongLengthOrARepeatedNameIsTheCallersBug) {
   d = two_tables();
   d.tables[0].columns[1].name = "vx";
   EXPECT_THROW(report::write_mdf4(d), std::invalid_argument);
+}
+
+// An export past a reply's limit comes in parts of whole tables, each file within the limit, and
+// the CLI joins them into the file the server would have written, byte for byte.
+TEST(Export, PartsPastAReplysLimitJoinIntoTheWholeFile) {
+  report::Mdf4Document d = two_tables();
+  const std::string whole = report::write_mdf4(d);
+  const std::size_t limit = whole.size() - 1;
+  const auto parts = report::export_parts(d.tables, limit, d.comment);
+  ASSERT_EQ(parts.size(), 2U);
+  std::vector<can::Mdf4File> files;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const std::string bytes = report::write_mdf4({d.start_ns, d.comment, parts[k]});
+    EXPECT_LE(bytes.size(), limit);
+    files.push_back(read_back(bytes));
+  }
+  EXPECT_EQ(cli::joined_export(files), whole);
+  EXPECT_EQ(report::export_parts(d.tables, whole.size(), d.comment).size(), 1U);
+  EXPECT_THROW(report::export_parts(d.tables, 400, d.comment),
+               InputError);  // a table alone is more
+  EXPECT_EQ(cli::part_count("application/x-mdf4; part=1/3"), 3U);
+  EXPECT_EQ(cli::part_count("application/x-mdf4"), 1U);
 }
 
 }  // namespace

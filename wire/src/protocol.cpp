@@ -31,7 +31,7 @@ const std::vector<RequestKind>& request_kinds() {
       {"consistency", {"vehicle", "run"}, {"reference", "format"}, {"reference"}, false},
       {"estimate", {"vehicle"}, {"run", "model", "format"}, {}, false},
       {"excitation", {"vehicle"}, {"run", "format"}, {}, false},
-      {"export", {"vehicle", "run"}, {"model", "effects"}, {}, false},
+      {"export", {"vehicle", "run"}, {"model", "effects", "part"}, {}, false},
       {"fleet", {"model", "shared", "vehicles"}, {"format"}, {"shared"}, false},
       {"iv", {"vehicle", "run", "model"}, {"effects", "format"}, {}, false},
       {"pooled", {"vehicle", "run"}, {"model", "format"}, {"run"}, false},

@@ -1,10 +1,13 @@
 #include "dynid/cli/export_file.hpp"
 
+#include <cstdlib>
 #include <map>
 #include <sstream>
 #include <vector>
 
 #include <fmt/format.h>
+
+#include "dynid/report/mdf4_writer.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -59,6 +62,35 @@ std::string wrapped(const std::string& line) {
 }
 
 }  // namespace
+
+std::size_t part_count(const std::string& payload_format) {
+  const auto slash = payload_format.rfind('/');
+  if (payload_format.find("; part=") == std::string::npos || slash == std::string::npos) return 1;
+  const unsigned long n = std::strtoul(payload_format.c_str() + slash + 1, nullptr, 10);
+  return n == 0 ? 1 : n;
+}
+
+std::string joined_export(const std::vector<can::Mdf4File>& parts) {
+  report::Mdf4Document document{parts.front().start_ns(), parts.front().comment(), {}};
+  for (const can::Mdf4File& file : parts)
+    for (std::size_t dg = 0; dg < file.data_groups().size(); ++dg) {
+      const auto& channel_groups = file.data_groups()[dg].groups;
+      for (std::size_t cg = 0; cg < channel_groups.size(); ++cg) {
+        std::vector<std::string> names;
+        for (const can::Mdf4Channel& c : channel_groups[cg].channels)
+          if (!c.is_master()) names.push_back(c.name);
+        can::Mdf4Signals signals = file.read_signals(dg, cg, names);
+        report::Mdf4Table table{
+            channel_groups[cg].name, channel_groups[cg].comment, std::move(signals.time), {}};
+        for (std::size_t i = 0; i < names.size(); ++i) {
+          const can::Mdf4Channel& c = *channel_groups[cg].find(names[i]);
+          table.columns.push_back({c.name, c.unit, c.comment, std::move(signals.values[i])});
+        }
+        document.tables.push_back(std::move(table));
+      }
+    }
+  return report::write_mdf4(document);
+}
 
 std::string export_csv(const can::Mdf4File& file) {
   const std::vector<Group> groups = read_groups(file);

@@ -149,18 +149,34 @@ int report_request(const Common& c, const std::string& kind, const std::vector<R
   return 0;
 }
 
-// An export (server/export_request.hpp): the server's MDF4 file, read back with the product's
-// reader (a file that does not read is not written), then written as it came or as one CSV table.
-int export_request(const Common& c, const std::vector<RequestArgument>& arguments,
+dynid::can::Mdf4File mdf4_of(const std::string& bytes, const std::string& what) {
+  return dynid::can::Mdf4File(std::vector<std::uint8_t>(bytes.begin(), bytes.end()), what);
+}
+
+// An export (server/export_request.hpp): the server's MDF4 file, its parts asked for and joined
+// when it is past a reply's limit, read back with the product's reader (a file that does not read
+// is not written), then written as it came or as one CSV table.
+int export_request(const Common& c, std::vector<RequestArgument> arguments,
                    const std::string& format, const std::string& output) {
+  arguments.push_back({"part", "1"});
   check_against_protocol("export", arguments);
   dynid::dds::Participant participant(participant_options(c));
   dynid::cli::RequestClient client(participant, dynid::cli::default_client_id());
-  const dynid::dds::Reply reply = client.call("export", arguments, timeout_of(c));
+  dynid::dds::Reply reply = client.call("export", arguments, timeout_of(c));
   if (reply.status != dynid::dds::ReplyStatus::kOk) return print("export", reply);
-  const dynid::can::Mdf4File file(
-      std::vector<std::uint8_t>(reply.payload.begin(), reply.payload.end()), "the server's export");
-  const std::string bytes = format == "csv" ? dynid::cli::export_csv(file) : reply.payload;
+  std::string mdf4 = std::move(reply.payload);
+  if (const std::size_t parts = dynid::cli::part_count(reply.payload_format); parts > 1) {
+    std::vector<dynid::can::Mdf4File> files{mdf4_of(mdf4, "the server's export, part 1")};
+    for (std::size_t k = 2; k <= parts; ++k) {
+      arguments.back().value = std::to_string(k);
+      reply = client.call("export", arguments, timeout_of(c));
+      if (reply.status != dynid::dds::ReplyStatus::kOk) return print("export", reply);
+      files.push_back(mdf4_of(reply.payload, "the server's export, part " + std::to_string(k)));
+    }
+    mdf4 = dynid::cli::joined_export(files);
+  }
+  const dynid::can::Mdf4File file = mdf4_of(mdf4, "the server's export");
+  const std::string bytes = format == "csv" ? dynid::cli::export_csv(file) : mdf4;
   std::ofstream out(output, std::ios::binary);
   out << bytes;
   if (!out.flush()) {

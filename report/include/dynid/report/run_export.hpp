@@ -10,6 +10,7 @@
 //   - "<model>.<group>.residual": y - W x.
 // The table's comment names the effects declared and the parameters' values with their standard
 // deviations, so that the file says which model its fitted values are.
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -26,5 +27,16 @@ std::vector<Mdf4Table> export_tables(const model::Model& model,
                                      const std::vector<std::string>& effects,
                                      const std::vector<ingest::PreprocessedSegment>& segments,
                                      double sample_rate_hz, int odmf);
+
+/// The export file's comment, one statement per line: the run, the time base, the models exported
+/// and, when any, those left out with why (`left_out`: "model: reason; ...").
+std::string export_comment(const std::string& run_name, const std::string& exported,
+                           const std::string& left_out);
+
+/// The tables, in order, cut into consecutive parts whose MDF4 files (each with `comment`) are
+/// at most `max_bytes` each: an export larger than a reply is sent in parts and joined again by
+/// the CLI. Throws InputError naming a table that is larger than `max_bytes` by itself.
+std::vector<std::vector<Mdf4Table>> export_parts(std::vector<Mdf4Table> tables,
+                                                 std::size_t max_bytes, const std::string& comment);
 
 }  // namespace dynid::report

@@ -56,6 +56,9 @@ std::map<std::string, double> parse_references(const std::vector<std::string>& a
 /// The trace's `rounds`: absent = 4; InputError unless an integer in 0..10.
 int parse_rounds(const std::optional<std::string>& text);
 
+/// export's `part`: absent = 1; InputError unless an integer from 1 (to a million).
+int parse_part(const std::optional<std::string>& text);
+
 /// add-effect's and trace's `series`: absent = false, "yes" = true; InputError otherwise.
 bool parse_series(const std::optional<std::string>& text);
 

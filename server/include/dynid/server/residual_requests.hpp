@@ -51,6 +51,7 @@ struct ResidualRequest {
   std::map<std::string, double> reference;          ///< add-effect, trace, consistency
   int rounds = 4;                                   ///< trace only
   bool series = false;  ///< json of add-effect and trace: the added effect's series row by row
+  int part = 1;         ///< export only: which part of an export past a reply's limit (1..N)
 };
 
 struct ResidualReply {

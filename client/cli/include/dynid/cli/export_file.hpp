@@ -11,13 +11,23 @@
 // "name [unit]" ("name" when it has no unit); a cell a group has no row for is empty; values are
 // written in the shortest form that reads back to the same double.
 //
+// An export past a reply's limit comes in parts (server/export_request.hpp): part_count() reads
+// their number from the reply's format, joined_export() joins the parts' files into the one file
+// the server would have written (the same bytes: tables in order, the first part's comment).
+//
 // export_summary(): per group its name, rows, time span and column count, and the file's
 // comment (which models it holds and which it left out, and why), lines within 100 columns.
+#include <cstddef>
 #include <string>
+#include <vector>
 
 #include <dynid/can/mdf4.hpp>
 
 namespace dynid::cli {
+
+/// N of "application/x-mdf4; part=K/N"; 1 when the format names no parts.
+std::size_t part_count(const std::string& payload_format);
+std::string joined_export(const std::vector<can::Mdf4File>& parts);
 
 std::string export_csv(const can::Mdf4File& file);
 std::string export_summary(const can::Mdf4File& file);
