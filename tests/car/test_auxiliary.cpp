@@ -1,7 +1,8 @@
 // Auxiliary sources (issue 17): a CSV source declared in the profile, merged into the run's grid
 // with the same gap and validity rules as bus channels, its clock fixed or estimated; and bad
 // auxiliary data (unknown columns, unsorted times, missing units, a drifting clock) refused with
-// a message naming the file, the line or the key.
+// a message naming the file, the line or the key. An MDF4 file of signals is a source as its CSV
+// is.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 
 #include <dynid/can/candump.hpp>
 #include <dynid/can/encoder.hpp>
+#include <dynid/can/mdf4.hpp>
 #include <dynid/error.hpp>
 
 #include "car_test_support.hpp"
@@ -19,6 +21,7 @@
 #include "dynid/car/clock_offset.hpp"
 #include "dynid/car/pipeline.hpp"
 #include "dynid/car/vehicle_profile.hpp"
+#include "dynid/report/mdf4_writer.hpp"
 
 namespace dynid::car {
 namespace {
@@ -160,6 +163,85 @@ TEST(CarAuxiliary, ASecondBusLogWithItsOwnDbcIsASource) {
                                           "\"\nclock = { offset = 0.0 }\n[[sources.channels]]\nname = \"yaw_rate\"\n"
                                           "message = \"NoSuchMessage\"\nsignal = \"X\"\n"); }),
              "sources[0].channels[0].message: unknown DBC message 'NoSuchMessage'");
+}
+
+// Issue 38, item 3: the logger's rows as an ASAM MDF4 file of physical channels are the same
+// source as its CSV file: the same chunks, value for value. Its channels are chosen by name,
+// wherever they are; a name no group or two groups hold is an error naming the groups.
+TEST(CarAuxiliary, AnMdf4FileOfSignalsIsTheSameSourceAsItsCsv) {
+  test::ScratchDir dir("aux-mdf4");
+  const RunSources from_csv =
+      prepare_sources(profile(kLogger), {{"logger", write_logger(dir)}}, nullptr);
+  report::Mdf4Table table{"logger", "", {}, {{"acc", "m/s^2", "", {}}, {"yaw", "deg/s", "", {}}}};
+  for (int i = 0; i <= 500; ++i) {
+    const double t = i * 0.02;
+    table.time_s.push_back(t * 1000.0 * 1e-3);  // the CSV's time in ms, read as seconds
+    table.columns[0].values.push_back(t);
+    table.columns[1].values.push_back(180.0 / std::numbers::pi);
+  }
+  const auto write = [&](const std::vector<report::Mdf4Table>& tables) {
+    const auto path = dir.path() / "logger.mf4";
+    std::ofstream(path, std::ios::binary) << report::write_mdf4({0, "", tables});
+    return path;
+  };
+  std::string mdf4_logger = kLogger;
+  const std::string csv_keys = "type = \"csv\"\ntime_column = \"t\"\ntime_unit = \"ms\"\n";
+  mdf4_logger.replace(mdf4_logger.find(csv_keys), csv_keys.size(), "type = \"mdf4\"\n");
+  const RunSources from_mdf4 =
+      prepare_sources(profile(mdf4_logger), {{"logger", write({table})}}, nullptr);
+  EXPECT_TRUE(from_mdf4.reports.at(0).warnings.empty()) << from_mdf4.reports.at(0).describe();
+  EXPECT_EQ(from_mdf4.reports.at(0).samples, from_csv.reports.at(0).samples);
+  const auto a = run_pipeline(from_csv), b = run_pipeline(from_mdf4);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].valid, b[k].valid) << "chunk " << k;
+    EXPECT_EQ(a[k].samples, b[k].samples) << "chunk " << k;
+  }
+  table.columns[1].unit = "rad/s";
+  const RunSources other_unit =
+      prepare_sources(profile(mdf4_logger), {{"logger", write({table})}}, nullptr);
+  ASSERT_EQ(other_unit.reports.at(0).warnings.size(), 1U);
+  EXPECT_EQ(
+      other_unit.reports.at(0).warnings[0],
+      "channel 'yaw': the file says 'rad/s', the profile 'deg/s': the profile's unit is used");
+  report::Mdf4Table second = table;
+  second.name = "logger2";
+  EXPECT_HAS(
+      error_of([&] {
+        (void)prepare_sources(profile(mdf4_logger), {{"logger", write({table, second})}}, nullptr);
+      }),
+      "source 'logger': channel 'acc' is in 2 channel groups: which one is meant cannot be told "
+      "(its channel groups: 'logger', 'logger2')");
+  table.columns[0].name = "accel";
+  EXPECT_HAS(error_of([&] {
+               (void)prepare_sources(profile(mdf4_logger), {{"logger", write({table})}}, nullptr);
+             }),
+             "source 'logger': no channel 'acc' in the file (its channel groups: 'logger')");
+}
+
+// A real decoded file (asammdf 7.0's decode of a CANedge log, ../shared/data) as an MDF4 source:
+// every value of the channel, on the header's clock.
+TEST(CarAuxiliary, AnAsammdfDecodedFileIsAnMdf4Source) {
+  const auto decoded = std::filesystem::path(DYNID_SHARED_DATA) / "mdf4-canedge" / "decoded" /
+                       "3BA199E2_00000164_00000001-60FE3F04.mf4";
+  if (!std::filesystem::exists(decoded)) GTEST_SKIP() << decoded << " is absent (../shared/data)";
+  const RunSources run = prepare_sources(
+      profile(
+          "[[sources]]\nname = \"decoded\"\ntype = \"mdf4\"\nclock = { offset = 0.0 }\n"
+          "[[sources.channels]]\ncolumn = \"AccelerationY\"\nchannel = \"ay\"\nunit = \"m/s^2\"\n"),
+      {{"decoded", decoded}}, nullptr);
+  const can::Mdf4File file(decoded);
+  std::uint64_t expected = 0;
+  for (const auto& dg : file.data_groups())
+    for (const auto& g : dg.groups)
+      if (g.find("AccelerationY") != nullptr) expected += g.cycle_count;
+  EXPECT_GT(expected, 1000U);
+  EXPECT_EQ(run.reports.at(0).samples, expected);
+  EXPECT_TRUE(run.reports.at(0).warnings.empty()) << run.reports.at(0).describe();
+  ASSERT_FALSE(run.samples.empty());
+  // Seconds since 1970: the recording is of 2021.
+  EXPECT_GT(run.samples.front().time, 1.6e9);
+  EXPECT_LT(run.samples.front().time, 1.7e9);
 }
 
 TEST(CarAuxiliary, AGapInTheSourceIsAGapOfItsChannelAsOnTheBus) {

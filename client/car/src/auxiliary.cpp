@@ -10,6 +10,8 @@
 #include <dynid/input/input_file.hpp>
 #include <dynid/input/number.hpp>
 
+#include <dynid/can/mdf4.hpp>
+
 #include "dynid/car/auxiliary_csv.hpp"
 #include "dynid/car/log_source.hpp"
 #include "dynid/car/signal_mapper.hpp"
@@ -120,9 +122,68 @@ ChannelMapping source_mapping(const AuxiliarySourceSpec& spec, std::size_t si, s
 
 namespace {
 
-// The source's channels as series on its own clock, in SI: a CSV file's columns, or the
-// channels a second bus's log gives through its DBC.
+// The channel group of `file` holding channel `name` (not as its master): {data group, channel
+// group}; InputError naming the file's groups when none or several hold it.
+std::pair<std::size_t, std::size_t> group_of(const can::Mdf4File& file, const std::string& name,
+                                             const std::string& where) {
+  std::vector<std::pair<std::size_t, std::size_t>> found;
+  std::string groups;
+  for (std::size_t dg = 0; dg < file.data_groups().size(); ++dg)
+    for (std::size_t cg = 0; cg < file.data_groups()[dg].groups.size(); ++cg) {
+      const can::Mdf4ChannelGroup& g = file.data_groups()[dg].groups[cg];
+      groups += (groups.empty() ? "'" : ", '") + g.name + "'";
+      if (const can::Mdf4Channel* c = g.find(name); c != nullptr && !c->is_master())
+        found.emplace_back(dg, cg);
+    }
+  if (found.size() == 1) return found.front();
+  throw InputError(where + ": " +
+                   (found.empty() ? "no channel '" + name + "' in the file"
+                                  : "channel '" + name + "' is in " + std::to_string(found.size()) +
+                                        " channel groups: which one is meant cannot be told") +
+                   " (its channel groups: " + (groups.empty() ? "none" : groups) + ")");
+}
+
+// An MDF4 file of physical channels (CANape, INCA, asammdf): each source channel is the file's
+// channel named by its `column`, at its channel group's master time after the header's start (s
+// since 1970, the clock of MDF4 and candump bus logs), from the profile's unit to SI.
+std::vector<TimeSeries> read_mdf4_source(const AuxiliarySourceSpec& spec, SourceReport& report) {
+  const can::Mdf4File file(report.file);
+  const std::string where = report.file.string() + ": source '" + spec.name + "'";
+  const double start = static_cast<double>(file.start_ns()) / 1e9;
+  std::vector<TimeSeries> series(spec.channels.size());
+  std::uint64_t dropped = 0;
+  for (std::size_t ci = 0; ci < spec.channels.size(); ++ci) {
+    const std::string& name = spec.channels[ci].column;
+    const auto [dg, cg] = group_of(file, name, where);
+    const can::Mdf4Channel& channel = *file.data_groups()[dg].groups[cg].find(name);
+    if (!channel.unit.empty() && channel.unit != spec.channels[ci].given_unit)
+      report.warnings.push_back("channel '" + name + "': the file says '" + channel.unit +
+                                "', the profile '" + spec.channels[ci].given_unit +
+                                "': the profile's unit is used");
+    const can::Mdf4Signals s = file.read_signals(dg, cg, {name});
+    TimeSeries& ts = series[ci];
+    for (std::size_t k = 0; k < s.time.size(); ++k) {
+      const double t = start + s.time[k], v = s.values[0][k];
+      if (!std::isfinite(v) || !std::isfinite(t) || (!ts.t.empty() && !(t > ts.t.back()))) {
+        ++dropped;
+        continue;
+      }
+      ts.t.push_back(t);
+      ts.v.push_back(auxiliary_si(spec, ci, v));
+    }
+  }
+  for (const std::string& note : file.notes()) report.warnings.push_back(note);
+  if (dropped > 0)
+    report.warnings.push_back(
+        std::to_string(dropped) +
+        " samples not finite or not after their channel's previous one dropped");
+  return series;
+}
+
+// The source's channels as series on its own clock, in SI: a CSV file's columns, an MDF4 file's
+// channels, or the channels a second bus's log gives through its DBC.
 std::vector<TimeSeries> read_source(const AuxiliarySourceSpec& spec, SourceReport& report) {
+  if (spec.type == "mdf4") return read_mdf4_source(spec, report);
   std::vector<TimeSeries> series(spec.channels.size());
   if (spec.type == "csv") {
     const AuxiliaryTable table = read_auxiliary_csv(spec, report.file);
@@ -189,6 +250,10 @@ RunSources prepare_sources(const VehicleProfile& declared, const std::map<std::s
     const auto it = given.find(spec.name);
     report.file = it != given.end() ? it->second : spec.file;
     if (!report.file.empty()) {
+      if (live && spec.type == "mdf4")
+        throw InputError("source '" + spec.name + "' (" + report.file.string() +
+                         "): an MDF4 file is read whole in "
+                         "a replay; a live run follows CSV files and CAN interfaces");
       if (live && spec.type != "csv" && !open_can)
         throw InputError("source '" + spec.name + "' (" + report.file.string() + "): a second CAN bus is read live "
                          "only by dynid-car (its interface), else from its log in a replay");

@@ -523,10 +523,13 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
     const toml::table& t = *a->get(i)->as_table();
     AuxiliarySourceSpec s;
     s.type = r.string(t, "type", key + ".type");
-    if (s.type != "csv" && s.type != "can")
-      r.fail(key + ".type", "unknown source type '" + s.type + "' (\"csv\" or \"can\")", t.get("type"));
+    if (s.type != "csv" && s.type != "can" && s.type != "mdf4")
+      r.fail(key + ".type", "unknown source type '" + s.type + "' (\"csv\", \"mdf4\" or \"can\")",
+             t.get("type"));
     if (s.type == "csv")
       r.only_keys(t, {"name", "type", "file", "time_column", "time_unit", "clock", "wait", "ecef", "channels"}, key + ".");
+    else if (s.type == "mdf4")
+      r.only_keys(t, {"name", "type", "file", "clock", "channels"}, key + ".");
     else
       r.only_keys(t, {"name", "type", "file", "dbc", "interfaces", "clock", "channels"}, key + ".");
     s.name = r.string(t, "name", key + ".name");
@@ -544,7 +547,7 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
       else if (unit == "ns") s.time_scale = 1e-9;
       else r.fail(key + ".time_unit", "expected \"s\", \"ms\", \"us\" or \"ns\"", t.get("time_unit"));
       if (t.contains("ecef")) s.ecef = read_ecef(r, t, key);
-    } else {
+    } else if (s.type == "can") {
       bus = std::make_shared<VehicleProfile>();
       bus->source = p.source;
       bus->vehicle = p.vehicle;
@@ -572,6 +575,10 @@ void read_sources(const Reader& r, const toml::table& root, VehicleProfile& p) {
         bus->channels.push_back(std::move(m));
       } else {
         c = read_source_channel(r, p, ct, ckey);
+        if (s.type == "mdf4" && !c.derived.empty())
+          r.fail(ckey + ".derived",
+                 "an MDF4 source's channels are its file's channels, named by `column`",
+                 ct.get("derived"));
       }
       if (!channels.insert(c.channel).second)
         r.fail(ckey + ".channel", "channel '" + c.channel + "' comes from two sources", ct.get("channel"));

@@ -14,6 +14,13 @@
 // Warnings (what was done): rows repeating the previous row's time are dropped, non-finite values
 // are left out. Columns the profile does not map are ignored (named in the report).
 //
+// MDF4 source: an ASAM MDF4 file of physical channels (CANape, INCA, asammdf, a logger's decoded
+// signals). Each source channel is the file's channel its `column` names, found in whichever
+// channel group holds it (an error naming the file's groups when none or several do), with its
+// conversion applied, at its group's master time after the header's start: seconds since 1970,
+// the clock of MDF4 and candump bus logs. The file's unit, where it differs from the profile's
+// `unit`, is a warning (the profile's is used). Read whole in a replay; not followed live.
+//
 // Clock: bus time = source time + offset, the offset fixed in the profile or estimated
 // (clock_offset.hpp) from a channel of the source against a bus channel decoded from the
 // replayed log (the bus mapping, even where the source replaces it in the run). A live run has

@@ -107,7 +107,7 @@ struct VehicleProfile;
 
 struct AuxiliarySourceSpec {
   std::string name;
-  std::string type;               ///< "csv" or "can"
+  std::string type;               ///< "csv", "mdf4" or "can"
   std::filesystem::path file;     ///< empty: given per run (--source NAME=FILE)
   std::string time_column;        ///< csv
   double time_scale = 1.0;        ///< csv: source time unit -> seconds
