@@ -335,8 +335,8 @@ ChannelMapping constant_channel(const Reader& r, const toml::table& t, const std
   }
   m.message = "constant";
   m.constant = value;
-  // Its samples come with the frames of every message, irregular as the bus is: no gap rule of
-  // its own, so a row's validity is that of the measured channels.
+  // Its samples come with every frame that carries a channel of the profile, irregular as the bus
+  // is: no gap rule of its own, so a row's validity is that of the measured channels.
   m.max_gap = kMaxSeconds;
   return m;
 }
