@@ -314,6 +314,7 @@ TEST(Export, PartsPastAReplysLimitJoinIntoTheWholeFile) {
                InputError);  // a table alone is more
   EXPECT_EQ(cli::part_count("application/x-mdf4; part=1/3"), 3U);
   EXPECT_EQ(cli::part_count("application/x-mdf4"), 1U);
+  EXPECT_THROW(cli::part_count("application/x-mdf4; part=1/2000000"), std::runtime_error);
 }
 
 }  // namespace

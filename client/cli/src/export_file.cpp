@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include <fmt/format.h>
@@ -12,30 +13,28 @@
 namespace dynid::cli {
 namespace {
 
-struct Group {
-  std::string name;
-  can::Mdf4Signals signals;
-  std::vector<std::string> units;  // of signals.names
-};
-
-// Every channel group of the file with all its channels but the master, as physical values.
-std::vector<Group> read_groups(const can::Mdf4File& file) {
-  std::vector<Group> groups;
+// Every channel group of the file as the writer's table: its master's times, and every other
+// channel with its unit, comment and physical values. One reading for the CSV, the summary and
+// the join of an export's parts.
+std::vector<report::Mdf4Table> read_tables(const can::Mdf4File& file) {
+  std::vector<report::Mdf4Table> tables;
   for (std::size_t dg = 0; dg < file.data_groups().size(); ++dg) {
     const auto& channel_groups = file.data_groups()[dg].groups;
     for (std::size_t cg = 0; cg < channel_groups.size(); ++cg) {
-      Group g{channel_groups[cg].name, {}, {}};
+      const can::Mdf4ChannelGroup& group = channel_groups[cg];
+      std::vector<const can::Mdf4Channel*> channels;
       std::vector<std::string> names;
-      for (const can::Mdf4Channel& c : channel_groups[cg].channels) {
-        if (c.is_master()) continue;
-        names.push_back(c.name);
-        g.units.push_back(c.unit);
-      }
-      g.signals = file.read_signals(dg, cg, names);
-      groups.push_back(std::move(g));
+      for (const can::Mdf4Channel& c : group.channels)
+        if (!c.is_master()) channels.push_back(&c), names.push_back(c.name);
+      can::Mdf4Signals signals = file.read_signals(dg, cg, names);
+      report::Mdf4Table table{group.name, group.comment, std::move(signals.time), {}};
+      for (std::size_t i = 0; i < channels.size(); ++i)
+        table.columns.push_back({channels[i]->name, channels[i]->unit, channels[i]->comment,
+                                 std::move(signals.values[i])});
+      tables.push_back(std::move(table));
     }
   }
-  return groups;
+  return tables;
 }
 
 std::string heading(const std::string& name, const std::string& unit) {
@@ -67,51 +66,37 @@ std::size_t part_count(const std::string& payload_format) {
   const auto slash = payload_format.rfind('/');
   if (payload_format.find("; part=") == std::string::npos || slash == std::string::npos) return 1;
   const unsigned long n = std::strtoul(payload_format.c_str() + slash + 1, nullptr, 10);
+  // The server numbers at most kMaxParts (its `part` check): a reply saying more is not ours.
+  if (n > kMaxParts)
+    throw std::runtime_error("the server's export says it has " + std::to_string(n) +
+                             " parts (at most " + std::to_string(kMaxParts) + ")");
   return n == 0 ? 1 : n;
 }
 
 std::string joined_export(const std::vector<can::Mdf4File>& parts) {
   report::Mdf4Document document{parts.front().start_ns(), parts.front().comment(), {}};
   for (const can::Mdf4File& file : parts)
-    for (std::size_t dg = 0; dg < file.data_groups().size(); ++dg) {
-      const auto& channel_groups = file.data_groups()[dg].groups;
-      for (std::size_t cg = 0; cg < channel_groups.size(); ++cg) {
-        std::vector<std::string> names;
-        for (const can::Mdf4Channel& c : channel_groups[cg].channels)
-          if (!c.is_master()) names.push_back(c.name);
-        can::Mdf4Signals signals = file.read_signals(dg, cg, names);
-        report::Mdf4Table table{
-            channel_groups[cg].name, channel_groups[cg].comment, std::move(signals.time), {}};
-        for (std::size_t i = 0; i < names.size(); ++i) {
-          const can::Mdf4Channel& c = *channel_groups[cg].find(names[i]);
-          table.columns.push_back({c.name, c.unit, c.comment, std::move(signals.values[i])});
-        }
-        document.tables.push_back(std::move(table));
-      }
-    }
+    for (report::Mdf4Table& table : read_tables(file)) document.tables.push_back(std::move(table));
   return report::write_mdf4(document);
 }
 
 std::string export_csv(const can::Mdf4File& file) {
-  const std::vector<Group> groups = read_groups(file);
-  // Columns in order of first appearance; each cell: (group, channel index) holding it.
-  std::vector<std::string> columns;
+  const std::vector<report::Mdf4Table> tables = read_tables(file);
+  // Columns in order of first appearance, a channel several tables hold once.
   std::map<std::string, std::size_t> column_of;
   std::string header = "time [s]";
-  for (const Group& g : groups)
-    for (std::size_t c = 0; c < g.signals.names.size(); ++c)
-      if (column_of.emplace(g.signals.names[c], columns.size()).second) {
-        columns.push_back(g.signals.names[c]);
-        header += "," + heading(g.signals.names[c], g.units[c]);
-      }
+  for (const report::Mdf4Table& t : tables)
+    for (const report::Mdf4Column& c : t.columns)
+      if (column_of.emplace(c.name, column_of.size()).second)
+        header += "," + heading(c.name, c.unit);
   std::map<double, std::vector<std::string>> rows;  // time -> cells, sorted by time
-  for (const Group& g : groups)
-    for (std::size_t k = 0; k < g.signals.time.size(); ++k) {
-      auto& cells = rows[g.signals.time[k]];
-      cells.resize(columns.size());
-      for (std::size_t c = 0; c < g.signals.names.size(); ++c) {
-        std::string& cell = cells[column_of.at(g.signals.names[c])];
-        if (cell.empty()) cell = fmt::format("{}", g.signals.values[c][k]);
+  for (const report::Mdf4Table& t : tables)
+    for (std::size_t k = 0; k < t.time_s.size(); ++k) {
+      auto& cells = rows[t.time_s[k]];
+      cells.resize(column_of.size());
+      for (const report::Mdf4Column& c : t.columns) {
+        std::string& cell = cells[column_of.at(c.name)];
+        if (cell.empty()) cell = fmt::format("{}", c.values[k]);
       }
     }
   std::string out = header + "\n";
@@ -125,11 +110,11 @@ std::string export_csv(const can::Mdf4File& file) {
 
 std::string export_summary(const can::Mdf4File& file) {
   std::string out;
-  for (const Group& g : read_groups(file)) {
-    const auto& t = g.signals.time;
-    out += fmt::format("  {}: {} rows", g.name, t.size());
+  for (const report::Mdf4Table& table : read_tables(file)) {
+    const auto& t = table.time_s;
+    out += fmt::format("  {}: {} rows", table.name, t.size());
     if (!t.empty()) out += fmt::format(" from {:.2f} to {:.2f} s", t.front(), t.back());
-    out += fmt::format(", {} columns\n", g.signals.names.size());
+    out += fmt::format(", {} columns\n", table.columns.size());
   }
   std::istringstream comment(file.comment());
   for (std::string line; std::getline(comment, line);) out += wrapped(line);

@@ -25,7 +25,11 @@
 
 namespace dynid::cli {
 
-/// N of "application/x-mdf4; part=K/N"; 1 when the format names no parts.
+/// The most parts an export has: the server's `part` argument goes to a million.
+inline constexpr std::size_t kMaxParts = 1000000;
+
+/// N of "application/x-mdf4; part=K/N"; 1 when the format names no parts; std::runtime_error for
+/// more than kMaxParts.
 std::size_t part_count(const std::string& payload_format);
 std::string joined_export(const std::vector<can::Mdf4File>& parts);
 
