@@ -101,7 +101,7 @@ double ParameterSample::simex_relative_error() const { return (simex_value - tru
 
 const std::vector<std::string>& models_of(benchcar::Manoeuvre manoeuvre) {
   static const std::vector<std::string> longitudinal = {"longitudinal_wheel", "longitudinal_engine"};
-  static const std::vector<std::string> lateral = {"lateral_bicycle"};
+  static const std::vector<std::string> lateral = {"lateral_bicycle", "lateral_bicycle_no_vy"};
   static const std::vector<std::string> launch = {"clutch_slip"};
   static const std::vector<std::string> none;
   switch (manoeuvre) {

@@ -13,6 +13,8 @@ namespace {
 
 constexpr double kErrorBound = 0.05;
 constexpr double kSameEstimate = 1e-9;  // relative: one fold of the same rows, rounding only
+// The lateral run's parameters with a truth: lateral_bicycle's 3, lateral_bicycle_no_vy's 4.
+constexpr std::size_t kLateralParameters = 7;
 
 bool positive(double x) { return std::isfinite(x) && x > 0.0; }
 
@@ -21,7 +23,9 @@ std::vector<std::string> check_seed(const SeedRun& r) {
   std::vector<std::string> failed;
   const std::string seed = "seed " + std::to_string(r.seed) + ": ";
   if (!r.error.empty()) failed.push_back(seed + r.error);
-  if (r.samples.size() != 3) failed.push_back(seed + std::to_string(r.samples.size()) + " parameters with a truth, not 3");
+  if (r.samples.size() != kLateralParameters)
+    failed.push_back(seed + std::to_string(r.samples.size()) + " parameters with a truth, not " +
+                     std::to_string(kLateralParameters));
   for (const ParameterSample& s : r.samples) {
     const std::string what = seed + s.model + " " + s.parameter;
     std::printf("%s = %.6g (table std %.3g, HAC std %.3g) against %.6g: error %+.2f %%\n", what.c_str(), s.value, s.std,
@@ -96,7 +100,9 @@ int run_smoke(const car::VehicleProfile& profile, const std::filesystem::path& w
   const std::vector<ParameterCoverage> rows = summarize(runs);
   std::printf("\n%s\n", markdown_table(rows).c_str());
   for (const std::string& f : check_summary(rows)) failed.push_back(f);
-  if (rows.size() != 3) failed.push_back("summary: " + std::to_string(rows.size()) + " rows, not 3");
+  if (rows.size() != kLateralParameters)
+    failed.push_back("summary: " + std::to_string(rows.size()) + " rows, not " +
+                     std::to_string(kLateralParameters));
   for (const std::string& f : check_mirror(profile, work_dir)) failed.push_back(f);
   for (const std::string& f : failed) std::printf("FAIL %s\n", f.c_str());
   std::printf("%zu failed checks\n", failed.size());

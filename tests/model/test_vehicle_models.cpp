@@ -302,6 +302,83 @@ TEST(LateralBicycle, SlipOffsetRecoversConstantSlipAngleOffsets) {
                     {"rear_slip_offset_force", kCr * kEr}});
 }
 
+// The linear bicycle (small slip angles, cos(steer) = 1) at varying speed, without vy on the
+// bus: every channel and derivative is the model's right-hand side at the sample (RK4 between
+// samples), so the no-vy model's equations hold exactly.
+model::ChannelSet linear_bicycle_run_without_vy() {
+  const Eigen::Index n = 4000;
+  const double dt = 0.01;
+  const Sines steer{0.0, {0.04, 0.015}, {0.9, 2.7}, {0.0, 0.4}};
+  const Sines speed{18.0, {5.0}, {0.1}, {0.0}};
+  struct Forces {
+    double front, rear, front_rate, rear_rate;
+  };
+  // The tyre forces and their rates at state s = (vy, r) with state derivative ds.
+  auto forces = [&](double t, const Eigen::Vector2d& s, const Eigen::Vector2d& ds) {
+    const double vx = speed.value(t), dvx = speed.derivative(t);
+    const double front = s(0) + kA * s(1), rear = s(0) - kB * s(1);
+    return Forces{kCf * (steer.value(t) - front / vx), -kCr * rear / vx,
+                  kCf * (steer.derivative(t) - (ds(0) + kA * ds(1)) / vx + front * dvx / (vx * vx)),
+                  -kCr * ((ds(0) - kB * ds(1)) / vx - rear * dvx / (vx * vx))};
+  };
+  auto rhs = [&](double t, const Eigen::Vector2d& s) {
+    const Forces f = forces(t, s, Eigen::Vector2d::Zero());  // the forces need no rates
+    return Eigen::Vector2d((f.front + f.rear) / kMass - s(1) * speed.value(t),
+                           (kA * f.front - kB * f.rear) / kYaw);
+  };
+  model::ChannelSet set(dt, n);
+  Eigen::VectorXd vx(n), dvx(n), r(n), dr(n), ay(n), day(n), st(n), dst(n);
+  Eigen::Vector2d s(0.0, 0.0);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double t = dt * static_cast<double>(k);
+    const Eigen::Vector2d ds = rhs(t, s);
+    const Forces f = forces(t, s, ds);
+    vx(k) = speed.value(t), dvx(k) = speed.derivative(t), r(k) = s(1), dr(k) = ds(1);
+    st(k) = steer.value(t), dst(k) = steer.derivative(t);
+    ay(k) = (f.front + f.rear) / kMass, day(k) = (f.front_rate + f.rear_rate) / kMass;
+    const Eigen::Vector2d k1 = ds, k2 = rhs(t + dt / 2, s + dt / 2 * k1),
+                          k3 = rhs(t + dt / 2, s + dt / 2 * k2), k4 = rhs(t + dt, s + dt * k3);
+    s += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
+  set.add("vx", "m/s", vx);
+  set.add("d_vx", "m/s^2", dvx);
+  set.add("yaw_rate", "rad/s", r);
+  set.add("d_yaw_rate", "rad/s^2", dr);
+  set.add("ay", "m/s^2", ay);
+  set.add("d_ay", "m/s^2/s", day);
+  set.add("steer", "rad", st);
+  set.add("d_steer", "rad/s", dst);
+  return set;
+}
+
+// What the no-vy model identifies, from the bicycle's constants.
+constexpr double kSteerPerYawAcceleration = kYaw * (kCf + kCr) / ((kA + kB) * kCf * kCr);
+constexpr double kUndersteerGradient = kMass * (kB * kCr - kA * kCf) / ((kA + kB) * kCf * kCr);
+
+TEST(LateralBicycleNoVy, KnownMassRecoversStiffnessesAndTheYawTerms) {
+  const auto m =
+      model::make_model("lateral_bicycle_no_vy", {{"a", kA}, {"b", kB}, {"mass", kMass}});
+  expect_recovered(identify(*m, linear_bicycle_run_without_vy()),
+                   {{"front_cornering_stiffness", kCf},
+                    {"rear_cornering_stiffness", kCr},
+                    {"steer_per_yaw_acceleration", kSteerPerYawAcceleration},
+                    {"understeer_gradient", kUndersteerGradient}});
+}
+
+TEST(LateralBicycleNoVy, UnknownMassRecoversPerUnitMassStiffnesses) {
+  const auto m = model::make_model("lateral_bicycle_no_vy", {{"a", kA}, {"b", kB}});
+  const Identified id = identify(*m, linear_bicycle_run_without_vy());
+  expect_recovered(id, {{"front_cornering_stiffness_per_mass", kCf / kMass},
+                        {"rear_cornering_stiffness_per_mass", kCr / kMass},
+                        {"steer_per_yaw_acceleration", kSteerPerYawAcceleration},
+                        {"understeer_gradient", kUndersteerGradient}});
+  // The yaw inertia per unit mass follows from the identified values (the header's identity).
+  const double cf = id.value("front_cornering_stiffness_per_mass");
+  const double cr = id.value("rear_cornering_stiffness_per_mass");
+  EXPECT_NEAR(id.value("steer_per_yaw_acceleration") * (kA + kB) * cf * cr / (cf + cr),
+              kYaw / kMass, 1e-6 * kYaw / kMass);
+}
+
 TEST(Kinematic, LongitudinalScaleOffsetAndGradeGain) {
   const Eigen::Index n = 2000;
   const Eigen::VectorXd t = time_grid(0.01, n);

@@ -571,9 +571,16 @@ Truth lateral(const CarParameters& car, const Perturbation& p, std::uint64_t see
     for (std::size_t i = 0; i < 4; ++i) y[i] += kDt / 6.0 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
   }
   Truth truth = make_truth(time, samples);
-  truth.parameters = {{"yaw_inertia", car.yaw_inertia},
-                      {"front_cornering_stiffness", car.front_cornering},
-                      {"rear_cornering_stiffness", car.rear_cornering}};
+  // lateral_bicycle_no_vy's yaw terms (lateral_no_vy.hpp), from the same car.
+  const double wheelbase = car.a + car.b, stiffnesses = car.front_cornering * car.rear_cornering;
+  truth.parameters = {
+      {"yaw_inertia", car.yaw_inertia},
+      {"front_cornering_stiffness", car.front_cornering},
+      {"rear_cornering_stiffness", car.rear_cornering},
+      {"steer_per_yaw_acceleration",
+       car.yaw_inertia * (car.front_cornering + car.rear_cornering) / (wheelbase * stiffnesses)},
+      {"understeer_gradient",
+       M * (car.b * car.rear_cornering - car.a * car.front_cornering) / (wheelbase * stiffnesses)}};
   if (p.rear_stiffness_step != 0.0) truth.change_time_s = p.step_time;
   return truth;
 }

@@ -70,6 +70,7 @@ const std::map<std::string, Entry, std::less<>>& entries() {
 // docs/CHANNELS.md: the unit of d_<name> is the unit of <name> per second.
 std::optional<std::string> per_second(const std::string& unit) {
   if (unit == "m/s") return "m/s^2";
+  if (unit == "m/s^2") return "m/s^2/s";  // as the server names d_ay's unit
   if (unit == "rad/s") return "rad/s^2";
   if (unit == "m" || unit == "rad") return unit + "/s";
   return std::nullopt;

@@ -8,6 +8,7 @@
 #include "dynid/model/clutch_slip.hpp"
 #include "dynid/model/kinematic.hpp"
 #include "dynid/model/lateral_bicycle.hpp"
+#include "dynid/model/lateral_no_vy.hpp"
 #include "dynid/model/locked_driveline.hpp"
 #include "dynid/model/longitudinal.hpp"
 #include "dynid/model/suspension.hpp"
@@ -30,6 +31,7 @@ const std::map<std::string, Factory>& registry() {
       {"longitudinal_engine", factory<Lon>(Lon::Source::kEngineTorque)},
       {"longitudinal_wheel", factory<Lon>(Lon::Source::kWheelTorque)},
       {"lateral_bicycle", factory<LateralBicycleModel>()},
+      {"lateral_bicycle_no_vy", factory<LateralNoVyModel>()},
       {"kinematic_longitudinal", factory<Kin>(Kin::Axis::kLongitudinal)},
       {"kinematic_lateral", factory<Kin>(Kin::Axis::kLateral)},
       {"body", factory<BodyModel>()},
