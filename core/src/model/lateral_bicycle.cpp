@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "dynid/model/effects.hpp"
 #include "support.hpp"
@@ -27,15 +28,7 @@ LateralBicycleModel::LateralBicycleModel(const Constants& constants) {
 }
 
 ParameterInfo LateralBicycleModel::scaled(ParameterInfo p) const {
-  if (mass_) return p;
-  p.name += "_per_mass";
-  p.unit += "/kg";
-  p.description += ", per unit mass";
-  // Dividing by an unknown M > 0 keeps a sign bound (0) and loses any other.
-  if (p.lower && *p.lower != 0.0) p.lower.reset();
-  if (p.upper && *p.upper != 0.0) p.upper.reset();
-  if (p.typical) *p.typical /= 1500.0;  // a typical passenger car's mass (kg)
-  return p;
+  return mass_ ? p : detail::per_unit_mass(std::move(p));
 }
 
 std::vector<ParameterInfo> LateralBicycleModel::parameters() const {

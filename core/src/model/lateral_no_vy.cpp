@@ -1,6 +1,7 @@
 #include "dynid/model/lateral_no_vy.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "support.hpp"
 
@@ -23,12 +24,7 @@ LateralNoVyModel::LateralNoVyModel(const Constants& constants) {
 }
 
 ParameterInfo LateralNoVyModel::scaled(ParameterInfo p) const {
-  if (mass_) return p;
-  p.name += "_per_mass";
-  p.unit += "/kg";
-  p.description += ", per unit mass";
-  if (p.typical) *p.typical /= 1500.0;  // a typical passenger car's mass (kg)
-  return p;
+  return mass_ ? p : detail::per_unit_mass(std::move(p));
 }
 
 std::vector<ParameterInfo> LateralNoVyModel::parameters() const {

@@ -86,6 +86,19 @@ inline ParameterInfo drag_area(std::string description) {
   return bounded(parameter("SCx", "m^2", std::move(description)), 0.0, 2.0);
 }
 
+/// The same quantity per unit of an unknown mass M (the lateral models without `mass`: their
+/// equations are homogeneous in M): name _per_mass, unit /kg. Dividing by M > 0 keeps a sign
+/// bound (0) and loses any other; a typical value is scaled by a passenger car's 1500 kg.
+inline ParameterInfo per_unit_mass(ParameterInfo p) {
+  p.name += "_per_mass";
+  p.unit += "/kg";
+  p.description += ", per unit mass";
+  if (p.lower && *p.lower != 0.0) p.lower.reset();
+  if (p.upper && *p.upper != 0.0) p.upper.reset();
+  if (p.typical) *p.typical /= 1500.0;
+  return p;
+}
+
 }  // namespace dynid::model::detail
 
 namespace dynid::model::detail {
