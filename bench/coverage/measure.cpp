@@ -3,9 +3,11 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <string>
 
 #include "car/clean_run.hpp"
 #include "car/declared_fit.hpp"
+#include "car/parameters.hpp"
 #include "car/product_path.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/residual/noise_floor.hpp"
@@ -34,8 +36,10 @@ residual::SimexFit declared_simex(const car::VehicleProfile& profile, const std:
 
 // Each parameter of one model that has a truth on this run, with both std. The parameter order
 // of the two fits is the model's (one fold of the same rows), checked by name all the same.
-void add_model(const car::VehicleProfile& profile, const std::string& model, const benchcar::CleanRun& run,
-               std::uint64_t seed, int simex_draws, std::vector<ParameterSample>& out) {
+// `label`: the model's name in the tables (a variant's, e.g. the gear inferred).
+void add_model(const car::VehicleProfile& profile, const std::string& model,
+               const benchcar::CleanRun& run, std::uint64_t seed, int simex_draws,
+               std::vector<ParameterSample>& out, const std::string& label) {
   const residual::ModelFit fit = benchcar::declared_fit(profile, model, run.product.recorded, run.segments);
   const residual::ModelParameters hac = benchcar::declared_hac(profile, model, run.product.recorded, run.segments);
   const residual::IvFit iv = benchcar::declared_iv(profile, model, run.product.recorded, run.segments);
@@ -50,7 +54,7 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
     const auto truth = run.truth.parameters.find(name);
     if (truth == run.truth.parameters.end()) continue;
     ParameterSample s;
-    s.model = model;
+    s.model = label;
     s.parameter = name;
     s.truth = truth->second;
     const auto k = static_cast<Eigen::Index>(i);
@@ -91,6 +95,22 @@ void add_model(const car::VehicleProfile& profile, const std::string& model, con
   }
 }
 
+// The engine model as a bus without a gear signal and without a gearbox input speed has it
+// (longitudinal.hpp, the gear inferred): the car's gear ratios, gearbox times final drive, given
+// as constants, so that the model reads engine_speed instead of the run's gear_ratio channel,
+// and a clutch slip tolerance no slip reaches, so that the run's gearbox_input_speed masks
+// nothing: the rows the inference leaves out are the only clutch mask.
+car::VehicleProfile with_gear_inferred(car::VehicleProfile profile) {
+  const benchcar::CarParameters car;
+  for (ingest::ModelSpec& m : profile.models) {
+    if (m.model != "longitudinal_engine") continue;
+    for (int gear = 1; gear <= static_cast<int>(car.gearbox.size()); ++gear)
+      m.constants["gear_ratio_" + std::to_string(gear)] = car.gear_ratio(gear);
+    m.constants["clutch_slip_tolerance"] = 1e9;  // rad/s
+  }
+  return profile;
+}
+
 }  // namespace
 
 double ParameterSample::relative_error() const { return (value - truth) / std::abs(truth); }
@@ -126,7 +146,10 @@ SeedRun measure_seed(const car::VehicleProfile& profile, benchcar::Manoeuvre man
   try {
     const benchcar::CleanRun run = benchcar::clean_run(profile, manoeuvre, seed, noise_scale, work_dir, mirrored);
     for (const std::string& model : models_of(manoeuvre))
-      add_model(profile, model, run, simex_seed, simex_draws, r.samples);
+      add_model(profile, model, run, simex_seed, simex_draws, r.samples, model);
+    if (manoeuvre == benchcar::Manoeuvre::kLongitudinal)
+      add_model(with_gear_inferred(profile), "longitudinal_engine", run, simex_seed, simex_draws,
+                r.samples, "longitudinal_engine, gear inferred");
   } catch (const std::exception& e) {
     r.error = e.what();
   }

@@ -155,6 +155,25 @@ TEST(BadProfiles, MissingConstantUnknownModelAndUnknownEffectAreNamed) {
   EXPECT_THROW(m->parameters_with({"flux_capacitor"}), InputError);
 }
 
+// The gears' ratios of an engine model that infers the gear: numbered from 1 without a hole,
+// and far enough apart that a measured ratio names one gear.
+TEST(BadProfiles, GearRatiosWithAHoleOrTooCloseAreRefused) {
+  model::Constants c{{"wheel_radius", 0.3}, {"air_density", 1.2},  {"driveline_efficiency", 0.9},
+                     {"gear_ratio_1", 8.9}, {"gear_ratio_2", 6.1}, {"gear_ratio_3", 4.5}};
+  EXPECT_NO_THROW(model::make_model("longitudinal_engine", c));
+  c["gear_ratio_5"] = 3.7;
+  expect_input_error([&] { model::make_model("longitudinal_engine", c); },
+                     {"'gear_ratio_5'", "without 'gear_ratio_4'"});
+  c.erase("gear_ratio_5");
+  c["gear_ratio_4"] = 4.6;  // 2 % above the third
+  expect_input_error([&] { model::make_model("longitudinal_engine", c); },
+                     {"4.5", "4.6", "gear_ratio_tolerance", "could be either gear"});
+  c["gear_ratio_4"] = 3.7;
+  c["gear_ratio_tolerance"] = -0.1;
+  expect_input_error([&] { model::make_model("longitudinal_engine", c); },
+                     {"gear_ratio_tolerance"});
+}
+
 TEST(BadProfiles, EveryRegisteredModelNeedsItsConstantsOrRunsWithout) {
   // Each registered model either builds from an empty profile or names what is missing.
   for (const std::string& name : model::model_names()) {

@@ -75,6 +75,49 @@ TEST(Longitudinal, EngineTorqueRecoversMassDragRollingAndGrade) {
                    {{"mass", kMass}, {"grade_mass_accelerometer", kMass}});
 }
 
+// A bus without a gear ratio (a manual car): the gears' ratios given as constants, the ratio of
+// each row is inferred from engine_speed r_w / vx; a shift (the engine between two gears' speeds)
+// and neutral are left out, and the truth comes back exactly, with the rotating inertia too.
+TEST(Longitudinal, TheGearInferredFromTheEngineSpeedRecoversTheTruth) {
+  LongitudinalRun run = longitudinal_run(0.0);
+  const Eigen::Index n = run.set.samples();
+  const Eigen::VectorXd t = time_grid(0.02, n);
+  constexpr double kEngineInertia = 0.2;  // kg m^2
+  const Eigen::VectorXd& vx = run.set["vx"];
+  const Eigen::VectorXd& dvx = run.set["d_vx"];
+  Eigen::VectorXd torque(n), engine(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double ratio = t(k) < 20.0 ? 8.9 : (t(k) < 40.0 ? 6.1 : 4.5);
+    engine(k) = ratio * vx(k) / kRadius;
+    // The engine's torque: what reaches the wheels through the driveline (the factor of its
+    // sign, eta G / r driving, G / (eta r) dragging) and what accelerates its own inertia.
+    const double inertia = kEngineInertia * ratio / kRadius * dvx(k);
+    const double driving = run.force(k) * kRadius / (kEta * ratio) + inertia;
+    torque(k) = driving >= 0.0 ? driving : run.force(k) * kRadius * kEta / ratio + inertia;
+    ASSERT_EQ(torque(k) >= 0.0, driving >= 0.0) << k;  // the sign decides the factor: one answer
+  }
+  torque.segment(1000, 200).setConstant(-999.0);  // braking
+  engine.segment(1500, 10).array() *= 7.5 / 6.1;  // a shift: between 6.1 and 8.9, 19 % off each
+  torque.segment(1500, 10).setConstant(-999.0);
+  engine.segment(2500, 10).setConstant(80.0);  // neutral: idling at 100 km/h
+  torque.segment(2500, 10).setConstant(-999.0);
+  run.set.add("engine_torque", "N m", torque);
+  run.set.add("engine_speed", "rad/s", engine);
+  const auto m = model::make_model("longitudinal_engine", {{"wheel_radius", kRadius},
+                                                           {"air_density", kRho},
+                                                           {"driveline_efficiency", kEta},
+                                                           {"gear_ratio_1", 8.9},
+                                                           {"gear_ratio_2", 6.1},
+                                                           {"gear_ratio_3", 4.5}});
+  EXPECT_TRUE(m->can_run_on(run.set));  // no gear_ratio channel
+  const Identified id = identify(*m, run.set, {"rotating_inertia"});
+  EXPECT_EQ(id.rows, static_cast<std::size_t>(n - 200 - 20));
+  expect_recovered(id, {{"mass", kMass},
+                        {"SCx", kSCx},
+                        {"rolling_resistance", kRolling},
+                        {"engine_inertia", kEngineInertia}});
+}
+
 // A clutch that slips for 0.1 s (a shift): with clutch_slip_margin the rows within that long of
 // a slipping sample are left out too, and reach() says how far a row reads.
 TEST(Longitudinal, TheSlipMarginLeavesOutTheRowsAroundASlippingClutch) {

@@ -1,6 +1,9 @@
 #include "dynid/model/longitudinal.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
 
 #include "dynid/error.hpp"
 #include "dynid/model/effects.hpp"
@@ -32,6 +35,37 @@ LongitudinalModel::LongitudinalModel(const Constants& constants, Source source) 
   brake_margin_ = c.optional("brake_margin").value_or(0.0);
   if (brake_margin_ < 0.0) brake_margin_ = c.positive("brake_margin", "s, >= 0");
   wheel_torque_zero_ = c.optional("wheel_torque_zero").value_or(0.0);
+  if (source_ == Source::kEngineTorque) read_gear_ratios(c);
+}
+
+void LongitudinalModel::read_gear_ratios(const ConstantReader& c) {
+  // Every name is asked for, so that `dynid models` and a profile's unread-constant check know
+  // them all.
+  std::vector<std::optional<double>> listed;
+  for (int gear = 1; gear <= kMaxGears; ++gear)
+    listed.push_back(c.optional("gear_ratio_" + std::to_string(gear)));
+  gear_ratio_tolerance_ = c.positive_or("gear_ratio_tolerance", 0.03);
+  for (int gear = 1; gear <= kMaxGears; ++gear) {
+    const std::string key = "gear_ratio_" + std::to_string(gear);
+    if (!listed[static_cast<std::size_t>(gear - 1)]) {
+      for (int later = gear + 1; later <= kMaxGears; ++later)
+        if (listed[static_cast<std::size_t>(later - 1)])
+          throw InputError("model '" + name() + "': constant 'gear_ratio_" + std::to_string(later) +
+                           "' is given without '" + key +
+                           "' (the gears are numbered from 1 without a hole)");
+      break;
+    }
+    gear_ratios_.push_back(
+        c.positive(key, "engine-to-wheel ratio in forward gear " + std::to_string(gear)));
+  }
+  std::sort(gear_ratios_.begin(), gear_ratios_.end());
+  for (std::size_t i = 1; i < gear_ratios_.size(); ++i)
+    if (gear_ratios_[i] <= gear_ratios_[i - 1] * std::pow(1.0 + gear_ratio_tolerance_, 2))
+      throw InputError(
+          "model '" + name() + "': gear ratios " + std::to_string(gear_ratios_[i - 1]) + " and " +
+          std::to_string(gear_ratios_[i]) + " are within twice gear_ratio_tolerance (" +
+          std::to_string(gear_ratio_tolerance_) + ") of each other: a measured ratio between " +
+          "them could be either gear");
 }
 
 std::string LongitudinalModel::name() const {
@@ -64,9 +98,10 @@ std::vector<ChannelNeed> LongitudinalModel::channels() const {
   std::vector<ChannelNeed> out{{"vx", "m/s"}, {"d_vx", "m/s^2"}};
   if (source_ == Source::kEngineTorque) {
     out.push_back({"engine_torque", "N m"});
-    out.push_back({"gear_ratio", "-"});
+    // With the gears' ratios listed the ratio is inferred from the engine speed (header).
+    if (gear_ratios_.empty()) out.push_back({"gear_ratio", "-"});
     out.push_back({"gear", "-", true});
-    out.push_back({"engine_speed", "rad/s", true});
+    out.push_back({"engine_speed", "rad/s", gear_ratios_.empty()});
     out.push_back({"gearbox_input_speed", "rad/s", true});
   } else {
     out.push_back({"wheel_torque", "N m"});
@@ -85,14 +120,36 @@ std::function<LongitudinalModel::Drive(Eigen::Index)> LongitudinalModel::drive(
     return [&t, r, zero = wheel_torque_zero_](Eigen::Index k) { return Drive{(t(k) - zero) / r, 1.0 / r}; };
   }
   const Eigen::VectorXd& t = set["engine_torque"];
-  const Eigen::VectorXd& ratio = set["gear_ratio"];
   const Eigen::VectorXd* gear = detail::find(set, "gear");
   const double eta = efficiency_;
-  return [&t, &ratio, gear, eta, r](Eigen::Index k) {
+  return [&t, ratio_at = ratio(set), gear, eta, r](Eigen::Index k) {
     if (gear != nullptr && std::lround((*gear)(k)) == 0) return Drive{0.0, 0.0};
     // Driving, the driveline loses (1 - eta) of the engine's power; dragging, of the wheels'.
-    const double factor = (t(k) >= 0.0 ? eta : 1.0 / eta) * ratio(k) / r;
+    const double factor = (t(k) >= 0.0 ? eta : 1.0 / eta) * ratio_at(k) / r;
     return Drive{t(k) * factor, factor};
+  };
+}
+
+std::function<double(Eigen::Index)> LongitudinalModel::ratio(const ChannelSet& set) const {
+  if (gear_ratios_.empty()) {
+    const Eigen::VectorXd& ratio = set["gear_ratio"];
+    return [&ratio](Eigen::Index k) { return ratio(k); };
+  }
+  const Eigen::VectorXd& engine = set["engine_speed"];
+  const Eigen::VectorXd& vx = set["vx"];
+  return [&engine, &vx, &listed = gear_ratios_, r = wheel_radius_,
+          limit = std::log1p(gear_ratio_tolerance_)](Eigen::Index k) {
+    const double measured = engine(k) * r / vx(k);
+    if (!(measured > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    // The nearest listed ratio in log: the first at or above the measured one, or the one below.
+    auto above = std::lower_bound(listed.begin(), listed.end(), measured);
+    double nearest = above == listed.end() ? listed.back() : *above;
+    if (above != listed.begin() &&
+        (above == listed.end() || std::log(measured / *(above - 1)) < std::log(*above / measured)))
+      nearest = *(above - 1);
+    return std::abs(std::log(measured / nearest)) <= limit
+               ? nearest
+               : std::numeric_limits<double>::quiet_NaN();
   };
 }
 
@@ -154,11 +211,10 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
        // this is J_e + J_in, not the clutch model's J_e.
        {positive(parameter("engine_inertia", "kg m^2", "rotating inertia on the engine side"))},
        {}},
-      [factor, r](const ChannelSet& set) -> detail::ValueFn {
-        const Eigen::VectorXd& ratio = set["gear_ratio"];
+      [this, factor, r](const ChannelSet& set) -> detail::ValueFn {
         const Eigen::VectorXd& dvx = set["d_vx"];
-        return [d = factor(set), &ratio, &dvx, r](Eigen::Index k) {
-          return d(k).factor * ratio(k) / r * dvx(k);
+        return [d = factor(set), ratio_at = ratio(set), &dvx, r](Eigen::Index k) {
+          return d(k).factor * ratio_at(k) / r * dvx(k);
         };
       }));
   return out;
@@ -182,10 +238,22 @@ RowModel::RowFn LongitudinalModel::bind(const ChannelSet& set,
   const Eigen::VectorXd& dvx = set["d_vx"];
   const Eigen::VectorXd* engine = detail::find(set, "engine_speed");
   const Eigen::VectorXd* input = detail::find(set, "gearbox_input_speed");
-  const bool slip_check = source_ == Source::kEngineTorque && engine != nullptr && input != nullptr;
+  const bool measured_slip =
+      source_ == Source::kEngineTorque && engine != nullptr && input != nullptr;
+  // With the gear inferred, a row no listed gear fits is a slipping or open clutch too (header),
+  // and its neighbours within clutch_slip_margin carry its transient as well.
+  const bool inferred_slip = source_ == Source::kEngineTorque && !gear_ratios_.empty();
+  const bool slip_check = measured_slip || inferred_slip;
+  const std::function<double(Eigen::Index)> ratio_at =
+      inferred_slip ? ratio(set) : std::function<double(Eigen::Index)>{};
   const std::vector<bool> slipping =
-      slip_check ? detail::within_margin_of(set.samples(), detail::margin_samples(slip_margin_, set.sample_period()),
-                                            [&](Eigen::Index k) { return std::abs((*engine)(k) - (*input)(k)) > slip_tolerance_; })
+      slip_check ? detail::within_margin_of(
+                       set.samples(), detail::margin_samples(slip_margin_, set.sample_period()),
+                       [&](Eigen::Index k) {
+                         return (measured_slip &&
+                                 std::abs((*engine)(k) - (*input)(k)) > slip_tolerance_) ||
+                                (inferred_slip && !std::isfinite(ratio_at(k)));
+                       })
                  : std::vector<bool>{};
   // Braking rows, and those within brake_margin of one (the low-pass spreads the brake force's
   // step over its impulse response, into rows whose own filtered pressure is below the threshold).
@@ -197,10 +265,12 @@ RowModel::RowFn LongitudinalModel::bind(const ChannelSet& set,
                                                    double& y) {
     if (std::abs(vx(k)) < min_speed_ || braking[static_cast<std::size_t>(k)]) return false;
     if (slip_check && slipping[static_cast<std::size_t>(k)]) return false;
+    const Drive d = drive(k);
+    if (!std::isfinite(d.factor)) return false;  // no listed gear fits the inferred ratio
     w[0] = dvx(k);
     w[1] = half_rho * detail::signed_square(vx(k));
     w[2] = detail::sgn(vx(k));
-    y = drive(k).force;
+    y = d.force;
     return true;
   };
 }

@@ -43,9 +43,25 @@
 // the constant, and least squares pays the mismatch in mass and SCx (reference simulator,
 // 5 N m per run: -1.6 .. +0.8 % on the mass with the seed; -0.4 % on every seed with no
 // offsets).
-// Effects: road_grade, road_grade_accelerometer, linear_drag, brake_drag; engine source also
-// engine_torque_offset and rotating_inertia (engine inertia seen through the gear: per-gear
-// equivalent mass M + eta J_e G^2 / r_w^2).
+// The gear inferred (engine source, a car whose bus has no gear ratio: a manual gearbox, most
+// production buses): with the constants gear_ratio_1 .. gear_ratio_<n> (the engine-to-wheel
+// ratio in each forward gear, gearbox times final drive, at most kMaxGears, numbered without a
+// hole) the model needs engine_speed instead of the gear_ratio channel. Each row's ratio is the
+// listed one nearest to engine_speed r_w / vx (in log, i.e. relatively); a row where none is
+// within gear_ratio_tolerance (relative, 0.03) is left out: the clutch slips or is open, or the
+// car is in neutral or shifting, and the engine torque does not reach the wheels through a known
+// ratio, and with it the rows within clutch_slip_margin of one, as for a measured slip. Why 3 %:
+// the measured ratio differs from the gear's by the driven tyres' slip (about 1 % at 2 m/s^2) and
+// their rolling radius against r_w (1-2 %), while a car's adjacent gears differ by 15 % or more (a
+// list whose neighbours are within twice the tolerance is refused: a ratio between them would name
+// either). A row whose clutch slips less than the tolerance keeps it: the torque it passes is the
+// engine's less J_e d(engine_speed)/dt, not zero; but there the engine's acceleration is not G dvx
+// / r_w, so rotating_inertia's column is off on those rows (the second car's launches:
+// engine_inertia -1.2 % at 3 %, -0.15 % at 0.5 %, with its exact r_w; docs/results/ACCURACY.md). A
+// profile whose rolling radius is measured can tighten it. Effects: road_grade,
+// road_grade_accelerometer, linear_drag, brake_drag; engine source also engine_torque_offset and
+// rotating_inertia (engine inertia seen through the gear: per-gear equivalent mass M + eta J_e G^2
+// / r_w^2).
 #include "dynid/model/constants.hpp"
 #include "dynid/model/row_model.hpp"
 
@@ -54,6 +70,8 @@ namespace dynid::model {
 class LongitudinalModel final : public RowModel {
  public:
   enum class Source { kEngineTorque, kWheelTorque };
+  /// Forward gears a profile may list (gear_ratio_1 .. gear_ratio_10).
+  static constexpr int kMaxGears = 10;
   LongitudinalModel(const Constants& constants, Source source);
 
   std::string name() const override;
@@ -75,6 +93,11 @@ class LongitudinalModel final : public RowModel {
     double factor;
   };
   std::function<Drive(Eigen::Index)> drive(const ChannelSet& channels) const;
+  // The engine-to-wheel ratio at each sample: the gear_ratio channel, or the listed gear's when
+  // inferred (NaN where no gear fits: the row is left out).
+  std::function<double(Eigen::Index)> ratio(const ChannelSet& channels) const;
+  // Reads gear_ratio_1 .. gear_ratio_<kMaxGears> and gear_ratio_tolerance (header).
+  void read_gear_ratios(const ConstantReader& c);
 
   Source source_;
   double wheel_radius_;
@@ -87,6 +110,8 @@ class LongitudinalModel final : public RowModel {
   double slip_margin_ = 0.0;  // s
   double brake_margin_ = 0.0;  // s
   double wheel_torque_zero_ = 0.0;  // N m
+  std::vector<double> gear_ratios_;  // ascending; empty: the gear_ratio channel is read
+  double gear_ratio_tolerance_ = 0.03;
 };
 
 }  // namespace dynid::model
