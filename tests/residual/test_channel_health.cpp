@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -214,6 +215,52 @@ TEST(ChannelHealth, ASpeedOutOfItsPhysicalRangeIsFoundWithItsExtreme) {
   // Every model here reads vx (kinematic_longitudinal through d_vx).
   for (const char* model : {"kinematic_longitudinal", "longitudinal_wheel", "lateral_bicycle"})
     EXPECT_TRUE(reads_unhealthy(run, health, model)) << model;
+}
+
+// The `p` quantile of |value| over the valid samples of `channel` (1: the largest).
+double quantile_of_magnitude(const ReplayedRun& run, const std::string& channel, double p) {
+  const auto column = static_cast<Eigen::Index>(run.announcement.column_of(channel));
+  std::vector<double> values;
+  for (const Chunk& chunk : run.chunks)
+    for (Eigen::Index i = 0; i < chunk.samples.rows(); ++i)
+      if (chunk.valid[static_cast<std::size_t>(i)] != 0)
+        values.push_back(std::abs(chunk.samples(i, column)));
+  std::sort(values.begin(), values.end());
+  return values[static_cast<std::size_t>(p * static_cast<double>(values.size() - 1))];
+}
+
+// A real log's longitudinal accelerometer with a range of half what the car reached (its
+// accelerations and brakings pass it 25 times): its peaks are cut flat, and the finding says so;
+// unedited, the same log has no finding (above).
+TEST(ChannelHealth, TheRav4LogsAccelerometerClippedByItsRangeIsFound) {
+  DYNID_REQUIRE_RAV4_DATA();
+  ReplayedRun run = replayed_rav4();
+  const double range = 0.5 * quantile_of_magnitude(run, "ax", 1.0);
+  edit_channel(run, "ax", [&](double x, double) { return std::clamp(x, -range, range); });
+  const RunHealth health = health_of(run);
+  const ChannelFinding& f = only_finding(health);
+  EXPECT_EQ(f.kind, HealthFinding::kClipped);
+  EXPECT_EQ(f.channel, "ax");
+  EXPECT_NEAR(std::abs(f.value), range, 1e-9);
+  EXPECT_NE(f.statement.find("`ax` clips at "), std::string::npos) << f.statement;
+  EXPECT_NE(f.statement.find("the sensor's range, not the car's motion"), std::string::npos)
+      << f.statement;
+  std::printf("%s\n", f.statement.c_str());
+}
+
+// The simulated acceleration run's longitudinal accelerometer with a range of 70 % of its
+// largest value: found, and the model that reads it is not judged; the others are.
+TEST(ChannelHealth, AClippedAccelerometerBlocksTheModelThatReadsIt) {
+  ReplayedRun run = acceleration_run();
+  const double range = 0.7 * quantile_of_magnitude(run, "ax", 1.0);
+  edit_channel(run, "ax", [&](double x, double) { return std::clamp(x, -range, range); });
+  const RunHealth health = health_of(run);
+  const ChannelFinding& f = only_finding(health);
+  EXPECT_EQ(f.kind, HealthFinding::kClipped);
+  EXPECT_EQ(f.channel, "ax");
+  EXPECT_GT(f.share, 0.0);
+  EXPECT_TRUE(reads_unhealthy(run, health, "kinematic_longitudinal"));
+  EXPECT_FALSE(reads_unhealthy(run, health, "lateral_bicycle"));
 }
 
 TEST(ChannelHealth, AMostlyInvalidRunIsReportedButBlocksNoModel) {

@@ -130,6 +130,91 @@ std::optional<ChannelFinding> out_of_range(const Series& s, const model::Channel
                             " " + where + ", reaching " + with_unit(extreme, s.unit)};
 }
 
+// The median of the non-zero steps between consecutive samples: the channel's own rate.
+double median_step(const std::vector<double>& v) {
+  std::vector<double> steps;
+  for (std::size_t k = 1; k < v.size(); ++k)
+    if (const double step = std::abs(v[k] - v[k - 1]); step > 0.0) steps.push_back(step);
+  if (steps.empty()) return 0.0;
+  const auto middle = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
+  std::nth_element(steps.begin(), middle, steps.end());
+  return *middle;
+}
+
+// Rule 2b on one side: the episodes held at `extreme` (within `tolerance`), whose signal
+// kApproach samples before and after is at least `steep` and the smooth-maximum bound away from
+// the extreme (header). An episode is a span of samples at the extreme and those within
+// kApproach samples of it that dip off it (a noisy signal above the range touches it again and
+// again); it counts with at least `min_samples` samples at the extreme. A smooth top held for L
+// samples within the tolerance has a curvature of at most 8 tolerance / ((L - 1) h)^2, so j
+// samples from its middle it is at most 4 tolerance (2 j / (L - 1))^2 away.
+constexpr std::size_t kApproach = 3;
+struct Episode {
+  Span span;
+  std::size_t at_extreme = 0;
+};
+std::vector<Episode> clipped_episodes(const std::vector<double>& v, double extreme,
+                                      double tolerance, double steep, int min_samples) {
+  const auto at = [&](std::size_t k) { return std::abs(v[k] - extreme) <= tolerance; };
+  std::vector<Episode> out;
+  for (std::size_t k = kApproach; k < v.size(); ++k) {
+    if (!at(k) || at(k - 1)) continue;
+    Episode e{{k, k}, 0};
+    for (std::size_t i = k; i < v.size() && i <= e.span.last + kApproach; ++i)
+      if (at(i)) e.span.last = i, ++e.at_extreme;
+    k = e.span.last;
+    // Too few samples at the extreme, or too near the series' end to judge the way out.
+    if (e.span.last + kApproach >= v.size() ||
+        e.at_extreme < static_cast<std::size_t>(std::max(min_samples, 2)))
+      continue;
+    const double j = static_cast<double>(e.span.size() - 1) / 2.0 + static_cast<double>(kApproach);
+    const double smooth =
+        4.0 * tolerance * std::pow(2.0 * j / static_cast<double>(e.at_extreme - 1), 2);
+    const double away = std::min(std::abs(extreme - v[e.span.first - kApproach]),
+                                 std::abs(extreme - v[e.span.last + kApproach]));
+    if (away >= steep && away > smooth) out.push_back(e);
+  }
+  return out;
+}
+
+std::optional<ChannelFinding> clipped(const Series& s, const model::ChannelPhysics& p,
+                                      const HealthRules& rules) {
+  if (!p.inertial || s.value.size() < 3) return std::nullopt;
+  const double tolerance = 1.001 * quantum(s.value);  // as rule 3's
+  const double steep = median_step(s.value);
+  if (!(steep > 0.0)) return std::nullopt;
+  const auto [lo, hi] = std::minmax_element(s.value.begin(), s.value.end());
+  std::vector<double> extremes;
+  std::vector<Episode> episodes;
+  for (const double extreme : {*lo, *hi}) {
+    const std::vector<Episode> side =
+        clipped_episodes(s.value, extreme, tolerance, steep, rules.min_clipped_samples);
+    if (side.size() < static_cast<std::size_t>(rules.min_clipped_spans)) continue;
+    extremes.push_back(extreme);
+    episodes.insert(episodes.end(), side.begin(), side.end());
+  }
+  if (episodes.empty()) return std::nullopt;
+  std::sort(episodes.begin(), episodes.end(),
+            [](const Episode& a, const Episode& b) { return a.span.first < b.span.first; });
+  std::size_t samples = 0;
+  for (const Episode& e : episodes) samples += e.at_extreme;
+  const double share = static_cast<double>(samples) / static_cast<double>(s.value.size());
+  std::string at = number(extremes.front());
+  if (extremes.size() == 2) at += " and " + number(extremes.back());
+  const std::size_t first = episodes.front().span.first, last = episodes.back().span.last;
+  return ChannelFinding{HealthFinding::kClipped,
+                        s.name,
+                        extremes.back(),
+                        s.time[first],
+                        s.time[last],
+                        share,
+                        "`" + s.name + "` clips at " + at + (s.unit == "-" ? "" : " " + s.unit) +
+                            ": held there " + std::to_string(episodes.size()) + " times " +
+                            span_text(s, first, last) + " (" + percent(share) +
+                            " of its valid samples), each entered and left steeply: the sensor's " +
+                            "range, not the car's motion"};
+}
+
 // Rule 3: the longest span held within the quantum, on a channel that holds only at rest.
 std::optional<ChannelFinding> held(const Series& s, const model::ChannelPhysics& p,
                                    const HealthRules& rules) {
@@ -213,6 +298,7 @@ RunHealth channel_health(const RecordedRun& run, const HealthRules& rules) {
     if (s.value.empty() || !physics) continue;  // a derivative or unknown name: no range to judge
     // A sentinel is held by definition: one statement says what it is.
     auto finding = out_of_range(s, *physics, rules);
+    if (!finding) finding = clipped(s, *physics, rules);
     if (!finding) finding = held(s, *physics, rules);
     if (finding) health.findings.push_back(std::move(*finding));
   }

@@ -24,15 +24,16 @@ std::vector<Entry> make_catalogue() {
   constexpr double kForce = 1e5;          // N, ten tonnes on one corner
   constexpr double kGravity = 9.80665;    // m/s^2: `az` at rest reads +g (specific force)
   constexpr bool kRestOnly = true;
+  constexpr bool kInertial = true;
   std::vector<Entry> c{{"vx", "m/s", {-kSpeed, kSpeed}}, {"vy", "m/s", {-kSpeed, kSpeed}}};
   for (const char* w : kCorners)
     c.push_back({std::string("wheel_speed_") + w, "m/s", {-kSpeed, kSpeed}});
-  c.push_back({"ax", "m/s^2", {-kAcceleration, kAcceleration, 0.0, kRestOnly}});
-  c.push_back({"ay", "m/s^2", {-kAcceleration, kAcceleration}});
-  c.push_back({"az", "m/s^2", {-kAcceleration, kAcceleration, kGravity, kRestOnly}});
+  c.push_back({"ax", "m/s^2", {-kAcceleration, kAcceleration, 0.0, kRestOnly, kInertial}});
+  c.push_back({"ay", "m/s^2", {-kAcceleration, kAcceleration, 0.0, false, kInertial}});
+  c.push_back({"az", "m/s^2", {-kAcceleration, kAcceleration, kGravity, kRestOnly, kInertial}});
   for (const char* n : {"roll_rate", "pitch_rate"})
-    c.push_back({n, "rad/s", {-kRate, kRate, 0.0, kRestOnly}});
-  c.push_back({"yaw_rate", "rad/s", {-kRate, kRate}});
+    c.push_back({n, "rad/s", {-kRate, kRate, 0.0, kRestOnly, kInertial}});
+  c.push_back({"yaw_rate", "rad/s", {-kRate, kRate, 0.0, false, kInertial}});
   c.insert(c.end(), {{"steer", "rad", {-kAngle, kAngle}},
                      {"engine_speed", "rad/s", {-kShaftSpeed, kShaftSpeed}},
                      {"engine_torque", "N m", {-5000.0, 5000.0}},

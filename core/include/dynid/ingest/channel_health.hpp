@@ -11,6 +11,16 @@
 //    raw value, an ECU's "not available"), not a measurement. Otherwise
 // 2. Out of range: any valid sample outside the physical range. The ranges are impossibilities
 //    on a car, so one such sample already says the decoding or the sensor is wrong.
+// 2b. Clipped: on an inertial sensor (model::ChannelPhysics::inertial), the channel's largest
+//    or smallest value is held, within its quantum, on at least `min_clipped_spans` separate
+//    spans of at least `min_clipped_samples` samples, and 3 samples before and after each span
+//    the signal is at least the channel's median step away from that value and further than a
+//    smooth maximum can be. Why that says "clipped": a smooth top held within a quantum q for L
+//    samples has a curvature of at most 8 q / ((L - 1) h)^2, so j samples from its middle it is
+//    at most 4 q (2 j / (L - 1))^2 below; a peak cut off by the sensor's range is entered and
+//    left at the signal's own rate. Several spans: a single one can be a steady state. Channels
+//    with an end stop or a limiter behind them (a steer at full lock, an engine at its rev limit, a
+//    closed clutch's load) hold flat tops of their own and are not judged.
 // 3. Constant (stuck): the longest span of consecutive valid samples whose values stay within
 //    the channel's quantum (the smallest non-zero step between consecutive valid samples seen
 //    anywhere in the run, 0 for a channel that never changes: a sensor cannot resolve less, so
@@ -47,9 +57,11 @@ struct HealthRules {
   double min_share = 0.5;          ///< rule 3: holding at least this share of the valid samples
   double sentinel_share = 0.5;     ///< rule 1: share of the out-of-range samples at one value
   double max_invalid_share = 0.5;  ///< rule 4
+  int min_clipped_spans = 3;       ///< rule 2b
+  int min_clipped_samples = 3;     ///< rule 2b: of each span
 };
 
-enum class HealthFinding { kSentinel, kOutOfRange, kConstant, kMostlyInvalid };
+enum class HealthFinding { kSentinel, kOutOfRange, kClipped, kConstant, kMostlyInvalid };
 
 struct ChannelFinding {
   HealthFinding kind = HealthFinding::kConstant;

@@ -28,6 +28,11 @@ struct ChannelPhysics {
   /// anywhere else, such a channel is stuck. Every other channel holds some value in a steady
   /// state (a speed, a steer, a static load, idle), so a held span is no fault of its own.
   bool holds_only_at_rest = false;
+  /// True for the inertial sensors (the accelerometer's three axes, the three rates): a car's
+  /// motion never stops one of them at a flat ceiling it enters and leaves steeply (there is no
+  /// end stop, limiter or saturating actuator behind them, unlike a steer at full lock, an engine
+  /// at its rev limit or a closed clutch), so such a ceiling is the sensor's range: clipping.
+  bool inertial = false;
 };
 /// The physics of a base catalogue channel; nullopt for d_<name> and unknown names.
 std::optional<ChannelPhysics> channel_physics(std::string_view channel);
