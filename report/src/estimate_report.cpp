@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "dynid/report/json.hpp"
+#include "dynid/report/text_wrap.hpp"
 
 namespace dynid::report {
 
@@ -60,9 +61,10 @@ const char* status_name(ls::ParameterStatus status) {
 
 std::string format_estimate_text(const dds::EstimateTable& t) {
   // Revision 0: a table no publication carried (a reprocessing, a stored history).
-  std::string out = t.revision == 0
-                        ? fmt::format("{} / {}  (source {}, not published)\n", t.vehicle, t.model, t.source)
-                        : fmt::format("{} / {}  (source {}, revision {})\n", t.vehicle, t.model, t.source, t.revision);
+  std::string out =
+      t.revision == 0
+          ? fmt::format("{} / {}  ({}, not published)\n", t.vehicle, t.model, t.source)
+          : fmt::format("{} / {}  ({}, revision {})\n", t.vehicle, t.model, t.source, t.revision);
   // A model read from an unhealthy channel, or one the run does not excite: one line, no
   // numbers that would read as estimates.
   if (!t.not_identified.empty())
@@ -84,10 +86,21 @@ std::string format_estimate_text(const dds::EstimateTable& t) {
   for (const auto& g : t.groups)
     out += fmt::format("  group {:<28} rows {:>8}  residual RMS {}\n", g.group, g.rows,
                        cell(g.residual_rms));
-  if (!t.residual_verdict.empty())
-    out += fmt::format("  residual loop (chunks through #{}): {}\n", t.residual_through, t.residual_statement);
+  if (!t.residual_verdict.empty()) {
+    // The answer first; its evidence (refused candidates, the residual's signature) is in the
+    // JSON and in `dynid residual`, which prints each on its own line.
+    const std::vector<std::string> parts = clauses(t.residual_statement);
+    out += wrap_text(fmt::format("  residual loop (chunks through #{}): ", t.residual_through),
+                     parts.front(), 4);
+    if (parts.size() > 1)
+      out += wrap_text("    ",
+                       fmt::format("and {} more finding{} (`dynid residual --model {}`, or --json)",
+                                   parts.size() - 1, parts.size() > 2 ? "s" : "", t.model),
+                       4);
+  }
   if (!t.bias_test.empty())
-    out += fmt::format("  bias test (chunks through #{}): {}\n", t.bias_through, t.bias_test);
+    out += wrap_text(fmt::format("  bias test (chunks through #{}): ", t.bias_through), t.bias_test,
+                     4);
   return out;
 }
 

@@ -6,6 +6,7 @@
 
 #include "dynid/report/estimate_report.hpp"
 #include "dynid/report/json.hpp"
+#include "dynid/report/text_wrap.hpp"
 
 namespace dynid::report {
 namespace {
@@ -31,7 +32,7 @@ std::string model_text(const ModelExcitation& m) {
   const dds::EstimateTable& t = m.table;
   // Read from an unhealthy channel: a manoeuvre cannot help, and nothing it says is a result.
   if (!t.not_identified.empty())
-    return fmt::format("  {}: not identified: {}\n", t.model, t.not_identified);
+    return wrap_text("  " + t.model + ": ", "not identified: " + t.not_identified, 4);
   std::vector<std::string> identified, poor, not_excited, implausible, structure;
   for (std::size_t j = 0; j < t.parameters.size(); ++j) {
     const dds::ParameterEntry& p = t.parameters[j];
@@ -46,15 +47,20 @@ std::string model_text(const ModelExcitation& m) {
       default: structure.push_back(p.name + " " + status_name(p.status) + (p.relation.empty() ? "" : " = " + p.relation));
     }
   }
-  std::string out = fmt::format("  {}: identifies {} of {}{}\n", t.model, identified.size(), t.parameters.size(),
-                                identified.empty() ? "" : ": " + join(identified));
-  if (!t.not_excited.empty()) out += "    not excited by this run at all: " + t.not_excited + "\n";
-  if (!not_excited.empty()) out += "    not excited: " + join(not_excited) + "\n";
-  if (!poor.empty()) out += "    poorly identified: " + join(poor) + "\n";
+  std::string out = wrap_text(
+      fmt::format("  {}: identifies {} of {}", t.model, identified.size(), t.parameters.size()),
+      identified.empty() ? "" : ": " + join(identified), 6);
+  if (!t.not_excited.empty())
+    out += wrap_text("    not excited by this run at all: ", t.not_excited, 6);
+  if (!not_excited.empty()) out += wrap_text("    not excited: ", join(not_excited), 6);
+  if (!poor.empty()) out += wrap_text("    poorly identified: ", join(poor), 6);
   if (!implausible.empty())
-    out += "    implausible, a model error or a missing effect rather than the manoeuvre (dynid residual): " +
-           join(implausible) + "\n";
-  if (!structure.empty()) out += "    not separable by this model on any run: " + join(structure) + "\n";
+    out += wrap_text(
+        "    implausible, a model error or a missing effect rather than the manoeuvre (dynid "
+        "residual): ",
+        join(implausible), 6);
+  if (!structure.empty())
+    out += wrap_text("    not separable by this model on any run: ", join(structure), 6);
   return out;
 }
 
@@ -101,16 +107,16 @@ std::vector<ManoeuvreNeed> manoeuvre_needs(const ExcitationReport& report) {
 std::string format_excitation_text(const ExcitationReport& report) {
   std::string out = fmt::format("{} / run {}: what this run identifies\n", report.vehicle, report.run);
   for (const ModelExcitation& m : report.models) out += model_text(m);
-  for (const std::string& n : report.notes) out += "  " + n + "\n";
+  for (const std::string& n : report.notes) out += wrap_text("  ", n, 4);
   const std::vector<ManoeuvreNeed> needs = manoeuvre_needs(report);
   if (needs.empty()) return out + "Every parameter this run can excite is identified.\n";
   out += "To identify what this run cannot, a run with:\n";
   for (const ManoeuvreNeed& n : needs) {
-    out += "  " + n.excited_by + ": ";
-    if (!n.not_excited.empty()) out += join(n.not_excited);
+    std::string what = join(n.not_excited);
     if (!n.poorly_identified.empty())
-      out += std::string(n.not_excited.empty() ? "" : "; ") + "better: " + join(n.poorly_identified);
-    out += "\n";
+      what +=
+          std::string(n.not_excited.empty() ? "" : "; ") + "better: " + join(n.poorly_identified);
+    out += wrap_text("  " + n.excited_by + ": ", what, 4);
   }
   return out;
 }

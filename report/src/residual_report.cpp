@@ -7,8 +7,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "dynid/residual/road_profile.hpp"
 #include "cells.hpp"
+#include "dynid/report/text_wrap.hpp"
+#include "dynid/residual/road_profile.hpp"
 
 namespace dynid::report {
 namespace {
@@ -84,11 +85,14 @@ std::string format_comparison_text(const residual::EffectComparison& c) {
   for (std::size_t g = 0; g < c.before.groups.size() && g < c.after.groups.size(); ++g) {
     const residual::GroupFit& b = c.before.groups[g];
     const residual::GroupFit& a = c.after.groups[g];
-    out += fmt::format("group {}: residual RMS in sample {} -> {}, held out {} -> {}; relative norm {:.4f} -> {:.4f} "
-                       "(held out {:.4f} -> {:.4f})\n",
-                       b.group, number(b.rms_in_sample), number(a.rms_in_sample), number(b.rms_held_out),
-                       number(a.rms_held_out), b.relative_norm_in_sample, a.relative_norm_in_sample,
-                       b.relative_norm_held_out, a.relative_norm_held_out);
+    out += wrap_text(
+        "group " + b.group + ": ",
+        fmt::format("residual RMS in sample {} -> {}, held out {} -> {}; relative norm {:.4f} -> "
+                    "{:.4f} (held out {:.4f} -> {:.4f})",
+                    number(b.rms_in_sample), number(a.rms_in_sample), number(b.rms_held_out),
+                    number(a.rms_held_out), b.relative_norm_in_sample, a.relative_norm_in_sample,
+                    b.relative_norm_held_out, a.relative_norm_held_out),
+        4);
   }
   return out + fmt::format("weighted residual RMS: {:.1f} % lower in sample, {:.1f} % lower held out\n",
                            100.0 * c.in_sample_drop(), 100.0 * c.held_out_drop());
@@ -108,23 +112,28 @@ std::string format_diagnosis_text(const residual::Diagnosis& d, std::size_t top)
   std::string out;
   for (const residual::GroupFloor& g : d.floor.groups)
     if (g.rows > 0)
-      out += fmt::format("group {}: residual RMS {} against a noise floor of {} (ratio of squares {:.3g}; at the "
-                         "floor up to {:.3g}, {:.0f} effective rows)\n",
-                         g.group, number(g.residual_rms), number(g.floor_rms), g.ratio, g.upper_ratio,
-                         g.effective_rows) +
-             scales_text(g);
+      out +=
+          wrap_text("group " + g.group + ": ",
+                    fmt::format(
+                        "residual RMS {} against a noise floor of {} (ratio of squares {:.3g}; at "
+                        "the floor up to {:.3g}, {:.0f} effective rows)",
+                        number(g.residual_rms), number(g.floor_rms), g.ratio, g.upper_ratio,
+                        g.effective_rows),
+                    4) +
+          scales_text(g);
   std::string noise;
   for (const residual::ChannelNoise& c : d.floor.channels)
     if (std::find(d.floor.contributing.begin(), d.floor.contributing.end(), c.channel) != d.floor.contributing.end())
       noise += fmt::format("{}{} {:.4g} ({})", noise.empty() ? "" : ", ", c.channel, c.sigma, c.source);
-  if (!noise.empty()) out += "noise of the channels the rows read: " + noise + "\n";
+  if (!noise.empty()) out += wrap_text("noise of the channels the rows read: ", noise, 4);
   out += format_screen_text(d.screen, top);
-  for (const residual::RefusedCandidate& r : d.refused) out += "refused: " + r.effect + ": " + r.reason + "\n";
-  for (const residual::Inseparable& i : d.inseparable) out += i.statement() + "\n";
+  for (const residual::RefusedCandidate& r : d.refused)
+    out += wrap_text("refused: " + r.effect + ": ", r.reason, 4);
+  for (const residual::Inseparable& i : d.inseparable) out += wrap_text("", i.statement(), 4);
   for (const residual::CorrelationFinding& f : d.signature.correlations)
     out += fmt::format("residual of {} correlates with {} at lag {:+.0f} ms: r = {:.2f} (bound {:.2f})\n", f.group,
                        f.channel, 1000.0 * f.lag_s, f.correlation, f.bound);
-  return out + "diagnosis: " + d.statement() + "\n";
+  return out + wrap_clauses("diagnosis: ", d.statement(), 4);
 }
 
 namespace {
@@ -161,15 +170,18 @@ std::string format_trace_text(const residual::Trace& t) {
                                 t.declared.empty() ? "none" : fmt::format("{}", fmt::join(t.declared, ", ")));
   for (std::size_t i = 0; i < t.rounds.size(); ++i) {
     const residual::TraceRound& r = t.rounds[i];
-    out += fmt::format("\n== round {} (effects: {}) ==\n{}\n", i + 1,
-                       r.effects.empty() ? "none" : fmt::format("{}", fmt::join(r.effects, ", ")),
-                       r.diagnosis.statement());
-    for (const residual::Inseparable& ins : r.diagnosis.inseparable) out += ins.statement() + "\n";
+    out += fmt::format("\n== round {} (effects: {}) ==\n", i + 1,
+                       r.effects.empty() ? "none" : fmt::format("{}", fmt::join(r.effects, ", "))) +
+           wrap_clauses("", r.diagnosis.statement(), 4);
+    for (const residual::Inseparable& ins : r.diagnosis.inseparable)
+      out += wrap_text("", ins.statement(), 4);
     if (r.added) out += format_comparison_text(*r.added);
   }
   const std::vector<std::string> added = t.added();
-  return out + fmt::format("\nadded: {}\nstopped: {}\n", added.empty() ? "nothing" : fmt::format("{}", fmt::join(added, ", ")),
-                           t.stopped);
+  return out +
+         fmt::format("\nadded: {}\n",
+                     added.empty() ? "nothing" : fmt::format("{}", fmt::join(added, ", "))) +
+         wrap_text("stopped: ", t.stopped, 4);
 }
 
 namespace {

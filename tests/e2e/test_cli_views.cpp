@@ -22,6 +22,7 @@
 #include "dynid/report/excitation_report.hpp"
 #include "dynid/report/mdf4_writer.hpp"
 #include "dynid/report/run_export.hpp"
+#include "dynid/report/text_wrap.hpp"
 
 namespace dynid::test {
 namespace {
@@ -117,6 +118,45 @@ dds::Reply status_reply(std::uint32_t shard, std::uint32_t count, const std::str
   r.shard = shard;
   r.shard_count = count;
   return r;
+}
+
+// Every line within the width, every word kept and whole, the continuation indented; a word
+// longer than a line stands alone.
+TEST(TextWrap, LinesFitTheWidthAndKeepEveryWord) {
+  std::string text;
+  for (int k = 0; k < 60; ++k)
+    text += (k ? " " : "") + std::string(static_cast<std::size_t>(1 + k % 9), 'a' + k % 26);
+  const std::string long_word(120, 'x');
+  const std::string out = report::wrap_text("  head: ", text + " " + long_word + " end", 4);
+  std::istringstream lines(out);
+  std::string line, words;
+  for (int n = 0; std::getline(lines, line); ++n) {
+    if (line.find(long_word) == std::string::npos) {
+      EXPECT_LE(line.size(), report::kTextWidth) << line;
+    }
+    if (n > 0) {
+      EXPECT_EQ(line.rfind("    ", 0), 0u) << line;
+    }
+    words += (n ? " " : "") + line.substr(n == 0 ? 8 : 4);
+  }
+  EXPECT_EQ(words, text + " " + long_word + " end");
+  EXPECT_EQ(out.back(), '\n');
+  EXPECT_EQ(report::wrap_text("short: ", "one line", 4), "short: one line\n");
+}
+
+// A statement's clauses split at "; " outside parentheses; each further one on its own line.
+TEST(TextWrap, ClausesSplitOutsideParentheses) {
+  const std::string statement =
+      "explained: above the noise floor (a residual RMS 1, noise floor 2; b residual RMS 3); "
+      "road_grade explains "
+      "it; x refused: why (p; q)";
+  const std::vector<std::string> parts = report::clauses(statement);
+  ASSERT_EQ(parts.size(), 3u);
+  EXPECT_EQ(parts[0],
+            "explained: above the noise floor (a residual RMS 1, noise floor 2; b residual RMS 3)");
+  EXPECT_EQ(parts[2], "x refused: why (p; q)");
+  EXPECT_EQ(report::wrap_clauses("diagnosis: ", statement, 4),
+            "diagnosis: " + parts[0] + "\n    road_grade explains it\n    x refused: why (p; q)\n");
 }
 
 TEST(StatusText, OneCounterPerLineWithWhatItCounts) {

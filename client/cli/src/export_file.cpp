@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "dynid/report/mdf4_writer.hpp"
+#include "dynid/report/text_wrap.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -43,21 +44,6 @@ std::string heading(const std::string& name, const std::string& unit) {
   std::string quoted = "\"";
   for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
   return quoted + "\"";
-}
-
-// A line of the file's comment, indented, broken at spaces before 100 columns.
-std::string wrapped(const std::string& line) {
-  constexpr std::size_t kWidth = 100;
-  std::string out, indent = "  ";
-  std::size_t start = 0;
-  while (line.size() - start + indent.size() > kWidth) {
-    const std::size_t space = line.rfind(' ', start + kWidth - indent.size());
-    if (space == std::string::npos || space <= start) break;
-    out += indent + line.substr(start, space - start) + "\n";
-    start = space + 1;
-    indent = "    ";
-  }
-  return out + indent + line.substr(start) + "\n";
 }
 
 }  // namespace
@@ -117,7 +103,7 @@ std::string export_summary(const can::Mdf4File& file) {
     out += fmt::format(", {} columns\n", table.columns.size());
   }
   std::istringstream comment(file.comment());
-  for (std::string line; std::getline(comment, line);) out += wrapped(line);
+  for (std::string line; std::getline(comment, line);) out += report::wrap_text("  ", line, 4);
   return out;
 }
 
