@@ -74,7 +74,7 @@ step() { awk -v s="$start" -v n="$(date +%s.%N)" -v m="$1" 'BEGIN { printf "\n==
 step "simulating a $scenario run of the test car"
 "$sim" --scenario "deploy/scenarios/$scenario.toml" ${SEED:+--seed "$SEED"} --out "$work/run"
 
-step "starting dynid-server (store $work/store.db, log $work/server.log)"
+step "starting dynid-server (its store and log in $work)"
 # OPENBLAS_NUM_THREADS=1: OpenBLAS starts its thread pool when the library loads, before
 # dynid-server blocks SIGTERM for its sigwait thread; such a thread would take the SIGTERM and
 # kill the server instead of stopping it cleanly. The server folds on its own workers anyway.
@@ -112,12 +112,12 @@ step "closing the run and asking for the estimates (dynid estimates --vehicle $v
 "$cli" --cyclone-config "$config" "${domain_args[@]}" close --vehicle "$vehicle" --run "$run_id" > /dev/null
 "$cli" --cyclone-config "$config" "${domain_args[@]}" estimates --vehicle "$vehicle"
 
-step "what this run identifies, and the manoeuvres for the rest (dynid excitation --vehicle $vehicle)"
+step "what the run identifies, and the manoeuvres for the rest (dynid excitation)"
 "$cli" --cyclone-config "$config" "${domain_args[@]}" excitation --vehicle "$vehicle"
 
 # The profile runs the lateral model bare: its table above says "identified" on precision
 # alone; the residual loop's verdict beside it says whether the model leaves structure.
-step "the server's live judgement of the bare lateral model (dynid estimates --model lateral_bicycle)"
+step "the live judgement of the bare lateral model (dynid estimates --model lateral_bicycle)"
 live_verdict "$run_id" lateral_bicycle "$work/car.log"
 
 # The effects the accuracy test found (tyre saturation, sensor offsets in the slip angles, roll
@@ -157,7 +157,7 @@ hill_run="hill-$(date -u +%Y%m%dT%H%M%SZ)"
   exit 1
 }
 "$cli" --cyclone-config "$config" "${domain_args[@]}" close --vehicle "$vehicle" --run "$hill_run" > /dev/null
-step "the server's live judgement of the run, published beside its estimates (dynid estimates --model)"
+step "the live judgement of the run, beside its estimates (dynid estimates --model)"
 # The estimates with the loop's verdict and the bias test (least squares against instrumental
 # variables, docs/ACCURACY.md) beneath.
 live_verdict "$hill_run" longitudinal_wheel "$work/hill-car.log"

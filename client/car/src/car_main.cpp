@@ -281,9 +281,9 @@ std::string replay_log(const Options& options, CarPipeline& pipe,
   log_left_out(pipe);
   if (done.rows > 0)  // where the run's times (row / rate) sit on the log's clock, e.g. to compare with its GNSS
     spdlog::info("grid row 0 is at {:.6f} s of the log's clock", pipe.origin());
-  spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids, {} timestamps out of range), {:.1f} s of "
-               "log, {} jumps of its clock, {} chunks",
-               done.frames, source.bad_input(), done.unknown_id, pipe.mapper_stats().bad_time, done.log_seconds,
+  spdlog::info("replay done: {} frames ({} bad lines, {} unknown ids, {} timestamps out of range)",
+               done.frames, source.bad_input(), done.unknown_id, pipe.mapper_stats().bad_time);
+  spdlog::info("the log: {:.1f} s, {} jumps of its clock, {} chunks", done.log_seconds,
                pipe.resampler_stats().pieces_ended, done.chunks);
   for (const auto& e : source.errors()) spdlog::warn("{}", e);
   const std::string problem = replay_problem(done);
@@ -393,8 +393,8 @@ struct Session {
     const std::string run = options.run.empty() ? default_run_id() : options.run;
     check_new_run(spool, profile.vehicle, run);
     delivery.announce(profile.announcement(run));
-    spdlog::info("run {}/{}: {} channels at {} Hz, {} rows per chunk", profile.vehicle, run, profile.channels.size(),
-                 profile.rate_hz, profile.chunk_rows);
+    spdlog::info("run {}/{}: {} channels, {} Hz, {} rows a chunk", profile.vehicle, run,
+                 profile.channels.size(), profile.rate_hz, profile.chunk_rows);
     // A replay can wait a moment until the server has taken the announcement (it answers with a
     // receipt), so the first chunks neither go into the void nor overtake the announcement
     // (both would be resent anyway); a live bus cannot wait.
@@ -450,8 +450,9 @@ int write_chunks(const Options& options) {
   ChunkFileWriter writer(options.chunks_out);
   CarPipeline pipe(profile, run, [&writer](dynid::ingest::Chunk&& chunk) { writer.write(chunk); });
   pipe.add_auxiliary(std::move(sources.samples));
-  spdlog::info("run {}/{}: {} channels at {} Hz, {} rows per chunk, chunks to {}", profile.vehicle, run,
-               profile.channels.size(), profile.rate_hz, profile.chunk_rows, options.chunks_out);
+  spdlog::info("run {}/{}: {} channels, {} Hz, {} rows a chunk", profile.vehicle, run,
+               profile.channels.size(), profile.rate_hz, profile.chunk_rows);
+  spdlog::info("chunks to {}", options.chunks_out);
   std::string problem;
   try {
     if (!options.replay.empty()) {
@@ -509,7 +510,7 @@ int run(const Options& options, ProgressDisplay& display) {
   if (!options.replay.empty()) probe_log(options, profile);
   const std::filesystem::path spool_dir = options.spool.empty() ? profile.spool_directory : std::filesystem::path(options.spool);
   Spool spool(spool_dir, profile.spool_max_bytes);
-  spdlog::info("vehicle {}: spool {} ({} chunks pending)", profile.vehicle, spool.file().string(), spool.count());
+  spdlog::info("spool {}: {} chunks pending", spool.file().string(), spool.count());
 
   dynid::dds::Participant participant({static_cast<dds_domainid_t>(options.domain), cyclone_config});
   Uplink uplink(participant, profile.vehicle);
@@ -535,10 +536,10 @@ int run(const Options& options, ProgressDisplay& display) {
     return session.spool_full ? kSpoolFull : kUndelivered;
   }
   spdlog::info(
-      "all chunks acknowledged: {} stored, {} sent, {} resent in {} rounds, {} rejections, {} "
-      "chunks "
-      "refused for good and set aside",
-      s.submitted, s.sent, s.resent, s.resend_rounds, s.rejections, s.set_aside);
+      "all chunks acknowledged: {} stored, {} sent, {} resent{}, {} rejected, {} set aside",
+      s.submitted, s.sent, s.resent,
+      s.resent == 0 ? "" : fmt::format(" in {} rounds", s.resend_rounds), s.rejections,
+      s.set_aside);
   if (!session.unusable_log.empty()) {  // what was good is delivered; the job was not done
     spdlog::error("{}", session.unusable_log);
     return kFailed;

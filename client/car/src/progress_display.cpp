@@ -75,17 +75,23 @@ std::string format_progress(const std::string& source, const ReplayProgress& rep
   char buf[512];
   std::string where;
   if (replay.fraction >= 0.0) {
-    std::snprintf(buf, sizeof buf, "replay %5.1f %% of %s | %.1f s of log", 100.0 * replay.fraction, source.c_str(),
-                  replay.log_seconds);
+    std::snprintf(buf, sizeof buf, "replay %5.1f %% of %s, %.1f s", 100.0 * replay.fraction,
+                  source.c_str(), replay.log_seconds);
     where = buf;
   } else {
     where = source;
   }
+  // The spool's size only when it holds something worth its own number (a link down).
+  const double mib = static_cast<double>(spool_bytes) / (1024.0 * 1024.0);
+  char spool[64];
+  if (mib >= 0.1)
+    std::snprintf(spool, sizeof spool, "%zu (%.1f MiB)", pending, mib);
+  else
+    std::snprintf(spool, sizeof spool, "%zu", pending);
   std::snprintf(buf, sizeof buf,
-                " | frames %" PRIu64 " | chunks %" PRIu64 ": sent %" PRIu64 ", acked %" PRIu64 ", resent %" PRIu64
-                " | spool %zu chunks, %.1f MiB",
-                replay.frames, delivery.submitted, delivery.sent, delivery.acknowledged, delivery.resent, pending,
-                static_cast<double>(spool_bytes) / (1024.0 * 1024.0));
+                " | %" PRIu64 " frames | chunks: %" PRIu64 " sent, %" PRIu64 " acked, %" PRIu64
+                " resent | spool %s",
+                replay.frames, delivery.sent, delivery.acknowledged, delivery.resent, spool);
   return where + buf;
 }
 
