@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "dynid/report/json.hpp"
 #include "dynid/report/text_wrap.hpp"
@@ -18,13 +20,14 @@ std::string cell(double value) {
 }
 
 std::string parameter_line(const dds::ParameterEntry& p) {
-  std::string line = fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {:<17}", p.name, p.unit,
-                                 cell(p.value), cell(p.standard_deviation),
-                                 cell(p.relative_std_percent), status_name(p.status));
+  std::string line =
+      fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {:<17}", p.name, p.unit, cell(p.value),
+                  cell(p.standard_deviation), cell(p.relative_std_percent), status_name(p.status));
   if (!p.relation.empty()) line += "  = " + p.relation;
   if (!p.reason.empty()) line += "  " + p.reason;
   if (!std::isnan(p.least_squares_value))
-    line += fmt::format("  (least squares {} +- {})", cell(p.least_squares_value), cell(p.least_squares_std));
+    line += fmt::format("  (least squares {} +- {})", cell(p.least_squares_value),
+                        cell(p.least_squares_std));
   while (!line.empty() && line.back() == ' ') line.pop_back();
   return line + "\n";
 }
@@ -44,17 +47,55 @@ std::string parameter_json(const dds::ParameterEntry& p, const std::string& not_
       json_number(p.least_squares_std));
 }
 
+// What the live verdict says the model lacks, in a few words ("" without a verdict): the
+// explaining effect by name, nothing, or something no candidate names. Diagnosis::statement()
+// is "<verdict>: ...; <effect> (<kind>...) explains it..." for an explained residual.
+std::string lacks(const dds::EstimateTable& t) {
+  const std::vector<std::string> parts = clauses(t.residual_statement);
+  if (t.residual_verdict == "adequate")
+    return parts.front().find("is at the noise floor") != std::string::npos
+               ? "lacks nothing its noise would not hide"
+               : "lacks nothing, but a declared signal is in error";
+  if (t.residual_verdict == "explained" && parts.size() > 1)
+    return "lacks " + parts[1].substr(0, parts[1].find(' '));
+  if (t.residual_verdict == "structure left")
+    return "lacks something no candidate effect explains in full";
+  return {};
+}
+
+// The model's answer in one line, before its table: what it lacks, then what the run identifies.
+std::string headline(const dds::EstimateTable& t) {
+  std::size_t identified = 0;
+  std::string implausible;
+  for (const auto& p : t.parameters) {
+    if (p.status == ls::ParameterStatus::kIdentified) ++identified;
+    if (p.status == ls::ParameterStatus::kImplausible)
+      implausible += (implausible.empty() ? "" : ", ") + p.name;
+  }
+  std::string out = fmt::format("{} of {} parameters identified", identified, t.parameters.size());
+  if (!implausible.empty()) out += "; implausible: " + implausible;
+  const std::string what = lacks(t);
+  return wrap_text("  answer: ", what.empty() ? out : what + "; " + out, 4);
+}
+
 }  // namespace
 
 const char* status_name(ls::ParameterStatus status) {
   switch (status) {
-    case ls::ParameterStatus::kIdentified: return "identified";
-    case ls::ParameterStatus::kRegrouped: return "regrouped";
-    case ls::ParameterStatus::kDependent: return "dependent";
-    case ls::ParameterStatus::kEliminated: return "eliminated";
-    case ls::ParameterStatus::kPoorlyIdentified: return "poorly identified";
-    case ls::ParameterStatus::kNotExcited: return "not excited";
-    case ls::ParameterStatus::kImplausible: return "implausible";
+    case ls::ParameterStatus::kIdentified:
+      return "identified";
+    case ls::ParameterStatus::kRegrouped:
+      return "regrouped";
+    case ls::ParameterStatus::kDependent:
+      return "dependent";
+    case ls::ParameterStatus::kEliminated:
+      return "eliminated";
+    case ls::ParameterStatus::kPoorlyIdentified:
+      return "poorly identified";
+    case ls::ParameterStatus::kNotExcited:
+      return "not excited";
+    case ls::ParameterStatus::kImplausible:
+      return "implausible";
   }
   return "unknown";
 }
@@ -68,15 +109,22 @@ std::string format_estimate_text(const dds::EstimateTable& t) {
   // A model read from an unhealthy channel, or one the run does not excite: one line, no
   // numbers that would read as estimates.
   if (!t.not_identified.empty())
-    return out + fmt::format("  not identified: {} ({} rows; --json has the numbers)\n",
-                             t.not_identified, t.rows);
+    return out +
+           wrap_text("  not identified: ",
+                     fmt::format("{} ({} rows; --json has the numbers)", t.not_identified, t.rows),
+                     4);
   if (!t.not_excited.empty())
-    return out + fmt::format("  not excited by this run: {} ({} rows; --json has the numbers)\n",
-                             t.not_excited, t.rows);
+    return out +
+           wrap_text("  not excited by this run: ",
+                     fmt::format("{} ({} rows; --json has the numbers)", t.not_excited, t.rows), 4);
+  out += headline(t);
   if (t.estimator == dds::kSimex)
-    out += "  values by SIMEX where marked (least squares corrected for the measured sensor noise)\n";
+    out +=
+        "  values by SIMEX where marked (least squares corrected for the measured sensor noise)\n";
   else if (t.estimator != dds::kLeastSquares)
-    out += fmt::format("  values by {} (least squares is biased on this run: see the bias test below)\n", t.estimator);
+    out += fmt::format(
+        "  values by {} (least squares is biased on this run: see the bias test below)\n",
+        t.estimator);
   out += fmt::format("  {:<24} {:<12} {:>14} {:>12} {:>9} {}\n", "parameter", "unit", "value",
                      "std", "rel.std%", "status");
   for (const auto& p : t.parameters) out += parameter_line(p);

@@ -111,6 +111,41 @@ TEST(EstimateText, AModelTheRunDoesNotExciteIsOneLineAndItsJsonKeepsTheNumbers) 
       << table_text;  // status, then its reason
 }
 
+// The answer before the table: what the live verdict says the model lacks, by the explaining
+// effect's name, then how many parameters the run identifies.
+TEST(EstimateText, TheAnswerComesFirstInOneLine) {
+  auto t = table(3, 160.0, 24.0);
+  EXPECT_NE(report::format_estimate_text(t).find("\n  answer: 1 of 2 parameters identified\n"),
+            std::string::npos)
+      << report::format_estimate_text(t);
+  t.residual_verdict = "explained";
+  t.residual_statement =
+      "explained: above the noise floor (longitudinal residual RMS 287.6, noise floor 86.36 (ratio "
+      "of squares 11.1, "
+      "at the floor up to 1.58)); road_grade (physics) explains it: held-out RMS -67.1 %, HAC Wald "
+      "p = 0 < 0.00016";
+  t.residual_through = 29;
+  const std::string text = report::format_estimate_text(t);
+  EXPECT_NE(text.find("\n  answer: lacks road_grade; 1 of 2 parameters identified\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(
+      text.find("and 1 more finding (`dynid residual --model longitudinal_wheel`, or --json)"),
+      std::string::npos)
+      << text;
+  t.residual_verdict = "adequate";
+  t.residual_statement =
+      "adequate: the residual of longitudinal_wheel is at the noise floor (longitudinal ...)";
+  EXPECT_NE(report::format_estimate_text(t).find(
+                "answer: lacks nothing its noise would not hide; 1 of 2"),
+            std::string::npos);
+  t.residual_verdict = "structure left";
+  t.residual_statement = "structure left that no candidate explains: above the noise floor (...)";
+  EXPECT_NE(report::format_estimate_text(t).find(
+                "answer: lacks something no candidate effect explains in full"),
+            std::string::npos);
+}
+
 dds::Reply status_reply(std::uint32_t shard, std::uint32_t count, const std::string& payload) {
   dds::Reply r;
   r.payload_format = "application/json";
