@@ -116,6 +116,14 @@ TEST(Longitudinal, TheGearInferredFromTheEngineSpeedRecoversTheTruth) {
                         {"SCx", kSCx},
                         {"rolling_resistance", kRolling},
                         {"engine_inertia", kEngineInertia}});
+  // With a gear channel, its neutral is a coast (no drive force), not a slipping clutch: those
+  // rows are kept.
+  Eigen::VectorXd gear = Eigen::VectorXd::Constant(n, 3.0);
+  gear.segment(2500, 10).setZero();
+  model::ChannelSet with_gear = run.set;
+  with_gear.add("gear", "-", gear);
+  const Identified neutral = identify(*m, with_gear, {"rotating_inertia"});
+  EXPECT_EQ(neutral.rows, static_cast<std::size_t>(n - 200 - 10));
 }
 
 // A clutch that slips for 0.1 s (a shift): with clutch_slip_margin the rows within that long of

@@ -214,7 +214,9 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
       [this, factor, r](const ChannelSet& set) -> detail::ValueFn {
         const Eigen::VectorXd& dvx = set["d_vx"];
         return [d = factor(set), ratio_at = ratio(set), &dvx, r](Eigen::Index k) {
-          return d(k).factor * ratio_at(k) / r * dvx(k);
+          // In neutral nothing turns the engine through a gear (and an inferred ratio is none).
+          const double drive = d(k).factor;
+          return drive == 0.0 ? 0.0 : drive * ratio_at(k) / r * dvx(k);
         };
       }));
   return out;
@@ -242,7 +244,9 @@ RowModel::RowFn LongitudinalModel::bind(const ChannelSet& set,
       source_ == Source::kEngineTorque && engine != nullptr && input != nullptr;
   // With the gear inferred, a row no listed gear fits is a slipping or open clutch too (header),
   // and its neighbours within clutch_slip_margin carry its transient as well.
+  // A gear channel's neutral (gear 0) is no slip: the drive is zero there, the row a coast.
   const bool inferred_slip = source_ == Source::kEngineTorque && !gear_ratios_.empty();
+  const Eigen::VectorXd* gear = detail::find(set, "gear");
   const bool slip_check = measured_slip || inferred_slip;
   const std::function<double(Eigen::Index)> ratio_at =
       inferred_slip ? ratio(set) : std::function<double(Eigen::Index)>{};
@@ -252,7 +256,8 @@ RowModel::RowFn LongitudinalModel::bind(const ChannelSet& set,
                        [&](Eigen::Index k) {
                          return (measured_slip &&
                                  std::abs((*engine)(k) - (*input)(k)) > slip_tolerance_) ||
-                                (inferred_slip && !std::isfinite(ratio_at(k)));
+                                (inferred_slip && !std::isfinite(ratio_at(k)) &&
+                                 !(gear != nullptr && std::lround((*gear)(k)) == 0));
                        })
                  : std::vector<bool>{};
   // Braking rows, and those within brake_margin of one (the low-pass spreads the brake force's
