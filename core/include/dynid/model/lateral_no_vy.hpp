@@ -30,8 +30,9 @@
 // c_f, c_r as well (K = (b / c_f - a / c_r) / L), and is identified on its own so that the yaw
 // equation stays linear: the two values of K are a check of the model, not a constraint.
 // The sideslip equation reads the derivatives of ay and steer: its regressors are small
-// differences of noisy signals, so on a noisy bus the stiffnesses are far less certain than K
-// and T, and least squares is attenuated by the regressors' noise (`dynid iv`, `dynid simex`).
+// differences of noisy signals, so the stiffnesses are less certain than with vy (on the second
+// car's swept sine: 0.9-1.0 % std against 0.2 %; T 0.3 %, K 0.7 %; docs/results/ACCURACY.md),
+// and least squares is attenuated by the regressors' noise (`dynid iv`, `dynid simex`).
 //
 // ay is taken at the CG (no imu_x: its correction would need the yaw rate's second derivative).
 // Rows left out, as lateral_bicycle's: vx < min_speed, braking (brake_pressure above
