@@ -31,19 +31,13 @@ Eigen::Index ClutchSlipModel::margin_samples(double sample_period) const {
 }
 
 RowReach ClutchSlipModel::reach(double sample_period) const {
-  RowReach r;
-  const Eigen::Index margin = margin_samples(sample_period);
-  r.back = std::max(r.back, margin);
-  r.ahead = std::max(r.ahead, margin);
-  return r;
+  return detail::widened(RowReach{}, stick_margin_, sample_period);
 }
 
 std::vector<bool> ClutchSlipModel::near_stick(const ChannelSet& set) const {
-  const Eigen::VectorXd& we = set["engine_speed"];
-  const Eigen::VectorXd& wi = set["gearbox_input_speed"];
   const Eigen::Index margin = margin_samples(set.sample_period());
-  std::vector<bool> out = detail::within_margin_of(
-      set.samples(), margin, [&](Eigen::Index k) { return std::abs(we(k) - wi(k)) < min_slip_; });
+  std::vector<bool> out =
+      detail::within_margin_of(set.samples(), margin, detail::clutch_sticks(set, min_slip_));
   if (open_clamp_load_ <= 0.0) return out;
   // The other state change: a row counted open (Gamma_n = 0) within the margin of a sample
   // that is not (the clutch closes or opens there).
@@ -106,13 +100,7 @@ std::vector<RowModel::EffectDefinition> ClutchSlipModel::effect_definitions() co
                        {parameter("viscous_friction", "s/rad", "mu_v")},
                        {}},
                       [](double slip) { return slip; }),
-      detail::one_column(
-          {effect::kTorqueOffset,
-           "ECU engine torque offset (true = ECU + T0)",
-           {detail::measures(parameter("engine_torque_offset", "N m", "T0", 0.0),
-                             "engine_torque_offset")},
-           {}},
-          [](const ChannelSet&) { return detail::ValueFn([](Eigen::Index) { return -1.0; }); })};
+      detail::clutch_torque_offset()};
   if (!stribeck_speed_) return out;
   const double vs = *stribeck_speed_;
   out.push_back(friction_effect(

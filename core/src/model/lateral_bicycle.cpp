@@ -56,11 +56,7 @@ std::vector<ChannelNeed> LateralBicycleModel::channels() const {
 }
 
 RowReach LateralBicycleModel::reach(double sample_period) const {
-  RowReach r = Model::reach(sample_period);
-  const Eigen::Index brake = detail::margin_samples(brake_margin_, sample_period);
-  r.back = std::max(r.back, brake);
-  r.ahead = std::max(r.ahead, brake);
-  return r;
+  return detail::widened(Model::reach(sample_period), brake_margin_, sample_period);
 }
 
 std::function<double(Eigen::Index)> LateralBicycleModel::road_plane_ay(const ChannelSet& set) const {

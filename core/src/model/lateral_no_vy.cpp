@@ -53,11 +53,7 @@ std::vector<ChannelNeed> LateralNoVyModel::channels() const {
 }
 
 RowReach LateralNoVyModel::reach(double sample_period) const {
-  RowReach r = Model::reach(sample_period);
-  const Eigen::Index brake = detail::margin_samples(brake_margin_, sample_period);
-  r.back = std::max(r.back, brake);
-  r.ahead = std::max(r.ahead, brake);
-  return r;
+  return detail::widened(Model::reach(sample_period), brake_margin_, sample_period);
 }
 
 RowModel::RowFn LateralNoVyModel::bind(const ChannelSet& set,

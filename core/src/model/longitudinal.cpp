@@ -223,15 +223,8 @@ std::vector<RowModel::EffectDefinition> LongitudinalModel::effect_definitions() 
 }
 
 RowReach LongitudinalModel::reach(double sample_period) const {
-  RowReach r = Model::reach(sample_period);
-  const Eigen::Index brake = detail::margin_samples(brake_margin_, sample_period);
-  r.back = std::max(r.back, brake);
-  r.ahead = std::max(r.ahead, brake);
-  if (source_ != Source::kEngineTorque) return r;
-  const Eigen::Index margin = detail::margin_samples(slip_margin_, sample_period);
-  r.back = std::max(r.back, margin);
-  r.ahead = std::max(r.ahead, margin);
-  return r;
+  const RowReach r = detail::widened(Model::reach(sample_period), brake_margin_, sample_period);
+  return source_ == Source::kEngineTorque ? detail::widened(r, slip_margin_, sample_period) : r;
 }
 
 RowModel::RowFn LongitudinalModel::bind(const ChannelSet& set,

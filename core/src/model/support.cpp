@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "dynid/error.hpp"
+#include "dynid/model/effects.hpp"
 
 namespace dynid::model::detail {
 
@@ -33,6 +34,21 @@ std::function<bool(Eigen::Index)> braking(const ChannelSet& set, double threshol
 ValueFn channel(const ChannelSet& set, const std::string& name) {
   const Eigen::VectorXd& x = set[name];
   return [&x](Eigen::Index k) { return x(k); };
+}
+
+std::function<bool(Eigen::Index)> clutch_sticks(const ChannelSet& set, double min_slip) {
+  return [&we = set["engine_speed"], &wi = set["gearbox_input_speed"], min_slip](Eigen::Index k) {
+    return std::abs(we(k) - wi(k)) < min_slip;
+  };
+}
+
+RowModel::EffectDefinition clutch_torque_offset() {
+  return one_column(
+      {effect::kTorqueOffset,
+       "ECU engine torque offset (true = ECU + T0)",
+       {measures(parameter("engine_torque_offset", "N m", "T0", 0.0), "engine_torque_offset")},
+       {}},
+      [](const ChannelSet&) { return ValueFn([](Eigen::Index) { return -1.0; }); });
 }
 
 RowModel::EffectDefinition brake_drag(const std::string& parameter_name, const std::string& unit) {
@@ -69,6 +85,13 @@ std::vector<bool> within_margin_of(Eigen::Index samples, Eigen::Index margin,
 
 Eigen::Index margin_samples(double margin_s, double sample_period) {
   return static_cast<Eigen::Index>(std::ceil(margin_s / sample_period - 1e-9));
+}
+
+RowReach widened(RowReach r, double margin_s, double sample_period) {
+  const Eigen::Index margin = margin_samples(margin_s, sample_period);
+  r.back = std::max(r.back, margin);
+  r.ahead = std::max(r.ahead, margin);
+  return r;
 }
 
 }  // namespace dynid::model::detail

@@ -118,6 +118,17 @@ std::vector<bool> within_margin_of(Eigen::Index samples, Eigen::Index margin,
 /// A margin in seconds as whole samples at `sample_period` (rounded up).
 Eigen::Index margin_samples(double margin_s, double sample_period);
 
+/// `r` widened to read `margin_s` on both sides of a row: a model whose mask looks that far
+/// (near_stick, braking) says so, so that a streaming caller keeps that much context.
+RowReach widened(RowReach r, double margin_s, double sample_period);
+
+/// A predicate "the clutch sticks at k": |engine_speed - gearbox_input_speed| < min_slip, where
+/// the slip's sign, and so the friction's, is undefined.
+std::function<bool(Eigen::Index)> clutch_sticks(const ChannelSet& set, double min_slip);
+
+/// The clutch models' ECU torque offset T0 (true = ECU + T0): a column -1 on the engine side.
+RowModel::EffectDefinition clutch_torque_offset();
+
 /// The brake-drag effect: a force or torque k_b p proportional to brake pressure, on the
 /// resisting side; `parameter_name`, `unit` of k_b.
 RowModel::EffectDefinition brake_drag(const std::string& parameter_name, const std::string& unit);
