@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
 
 #include "dynid/error.hpp"
 #include "dynid/model/channel_set.hpp"
+#include "dynid/model/clutch_torque_curve.hpp"
 #include "dynid/model/registry.hpp"
 #include "dynid/model/stribeck_bank.hpp"
 #include "model_test_support.hpp"
@@ -266,6 +268,114 @@ TEST(ClutchSlip, BorsottoFrictionCaseCoulombViscousStribeck) {
   expect_within_bounds(stribeck, {{"coulomb_friction", kBorsotto.coulomb},
                                   {"stribeck_friction", kBorsotto.stribeck},
                                   {"viscous_friction", kBorsotto.viscous}});
+}
+
+// A car without a clamp-load sensor (clutch_torque_curve): the clamp load is a piecewise linear
+// function of the clutch's engagement with knots where the model's are, so the curve
+// C(e) = mu_c R F(e) and the viscous curve mu_v R F(e) are recovered exactly at the knots, with
+// J_e and the ECU's torque offset (the open rows, a standing car revving with the pedal down, tell
+// the offset from the curve).
+constexpr double kTouchPoint = 0.2;
+constexpr std::array<double, 4> kKnotLoads{1500.0, 4000.0, 7000.0, 9000.0};  // N at e = 0.4 .. 1
+
+double knot_load(double e) {
+  if (e <= kTouchPoint) return 0.0;
+  if (e >= 1.0) return kKnotLoads.back();
+  const double x = (e - kTouchPoint) / 0.2;  // knots 0.2 apart
+  const auto j = static_cast<std::size_t>(x);
+  const double lower = j == 0 ? 0.0 : kKnotLoads[j - 1];
+  return lower + (x - static_cast<double>(j)) * (kKnotLoads[j] - lower);
+}
+
+model::ChannelSet engagement_run(double offset) {
+  const model::ChannelSet base = slipping_run(kClio, kEngineInertia);
+  const Eigen::Index n = base.samples();
+  const Eigen::VectorXd t = time_grid(0.01, n);
+  const Sines engagement{0.6, {0.45, 0.1}, {0.3, 1.7}, {0.0, 0.4}};  // from open to beyond 1
+  const Eigen::VectorXd e = engagement.values(t);
+  const Eigen::VectorXd slip = base["engine_speed"] - base["gearbox_input_speed"];
+  Eigen::VectorXd torque(n);
+  for (Eigen::Index k = 0; k < n; ++k)
+    torque(k) =
+        kEngineInertia * base["d_engine_speed"](k) +
+        kRadius * knot_load(e(k)) * (kClio.coulomb * sgn(slip(k)) + kClio.viscous * slip(k)) -
+        offset;
+  model::ChannelSet set(base.sample_period(), n);
+  for (const std::string name : {"engine_speed", "d_engine_speed", "gearbox_input_speed"})
+    set.add(name, base.unit(name), base[name]);
+  set.add("engine_torque", "N m", torque);
+  set.add("clutch_engagement", "-", e);
+  return set;
+}
+
+TEST(ClutchTorqueCurve, ExactRecoveryOfInertiaTheCurveAndTheTorqueOffset) {
+  const model::ChannelSet set = engagement_run(-15.0);
+  const auto m = model::make_model("clutch_torque_curve", {{"touch_point", kTouchPoint}});
+  std::map<std::string, double> truth{{"engine_inertia", kEngineInertia},
+                                      {"engine_torque_offset", -15.0}};
+  for (std::size_t j = 0; j < kKnotLoads.size(); ++j) {
+    truth["clutch_torque_" + std::to_string(j + 1)] = kClio.coulomb * kRadius * kKnotLoads[j];
+    truth["clutch_viscous_" + std::to_string(j + 1)] = kClio.viscous * kRadius * kKnotLoads[j];
+  }
+  expect_recovered(identify(*m, set, {"viscous_friction", "engine_torque_offset"}), truth);
+  // Open rows carry no curve column; the rows at the sticking slip are left out.
+  const auto rows = m->rows(set);
+  const Eigen::VectorXd slip = set["engine_speed"] - set["gearbox_input_speed"];
+  for (const Eigen::Index k : rows[0].samples) EXPECT_GE(std::abs(slip(k)), 1e-3);
+  EXPECT_LT((set["clutch_engagement"].array() <= kTouchPoint).count(), set.samples());
+}
+
+// open_engagement: rows below it carry no curve column, and those within stick_margin of a row
+// above it are left out (the clutch's first bite, smeared by the filter).
+TEST(ClutchTorqueCurve, RowsBelowOpenEngagementAreOpenAndThoseNearTheBiteAreLeftOut) {
+  const model::ChannelSet set = engagement_run(0.0);
+  const double open = 0.3;
+  const auto m = model::make_model(
+      "clutch_torque_curve",
+      {{"touch_point", kTouchPoint}, {"open_engagement", open}, {"stick_margin", 0.05}});
+  const Eigen::VectorXd& e = set["clutch_engagement"];
+  const auto rows = m->rows(set);
+  Eigen::Index open_rows = 0;
+  for (std::size_t r = 0; r < rows[0].samples.size(); ++r) {
+    const Eigen::Index k = rows[0].samples[r];
+    if (e(k) > open) continue;
+    ++open_rows;
+    EXPECT_EQ(rows[0].W.row(static_cast<Eigen::Index>(r)).tail(4).norm(), 0.0) << k;
+    for (Eigen::Index j = std::max<Eigen::Index>(0, k - 5); j <= std::min(set.samples() - 1, k + 5);
+         ++j)
+      EXPECT_LE(e(j), open) << "open row " << k << " within the margin of " << j;
+  }
+  EXPECT_GT(open_rows, 100);
+}
+
+TEST(ClutchTorqueCurve, TheBasisIsZeroWhenOpenAndSumsToOneWhenClosing) {
+  const model::ClutchTorqueCurveModel m({{"touch_point", 0.1}, {"torque_curve_knots", 3.0}});
+  ASSERT_EQ(m.knots().size(), 3u);
+  EXPECT_DOUBLE_EQ(m.knots().back(), 1.0);
+  for (const double e : {-0.2, 0.0, 0.1}) {
+    for (const double phi : m.basis(e)) EXPECT_EQ(phi, 0.0);
+  }
+  for (const double e : {0.4, 0.55, 0.7, 0.99, 1.0, 1.3}) {
+    const std::vector<double> phi = m.basis(e);
+    EXPECT_NEAR(phi[0] + phi[1] + phi[2], 1.0, 1e-15) << e;
+  }
+  // Between the touch point and the first knot the curve rises from 0.
+  EXPECT_NEAR(m.basis(0.25)[0], 0.5, 1e-12);
+}
+
+TEST(ClutchTorqueCurve, BadConstantsAreRefusedNamingThem) {
+  for (const model::Constants& c :
+       {model::Constants{{"touch_point", 1.0}}, model::Constants{{"touch_point", -0.1}},
+        model::Constants{{"torque_curve_knots", 2.5}},
+        model::Constants{{"torque_curve_knots", 11.0}},
+        model::Constants{{"open_engagement", 1.0}}}) {
+    try {
+      model::make_model("clutch_torque_curve", c);
+      ADD_FAILURE() << c.begin()->first;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.begin()->first), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(StribeckSpeedBank, PicksBorsottoStribeckSpeedAmongCandidates) {

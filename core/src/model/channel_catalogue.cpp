@@ -41,6 +41,7 @@ std::vector<Entry> make_catalogue() {
                      {"gear", "-", {-2.0, 20.0}},
                      {"gear_ratio", "-", {-100.0, 100.0}},
                      {"clutch_clamp_load", "N", {-kForce, kForce}},
+                     {"clutch_engagement", "-", {-0.5, 1.5}},
                      {"wheel_torque", "N m", {-30000.0, 30000.0}},
                      {"brake_pressure", "Pa", {-1e6, 5e7}},
                      {"road_grade", "rad", {-0.6, 0.6}},

@@ -6,6 +6,7 @@
 #include "dynid/error.hpp"
 #include "dynid/model/body.hpp"
 #include "dynid/model/clutch_slip.hpp"
+#include "dynid/model/clutch_torque_curve.hpp"
 #include "dynid/model/kinematic.hpp"
 #include "dynid/model/lateral_bicycle.hpp"
 #include "dynid/model/lateral_no_vy.hpp"
@@ -44,6 +45,7 @@ const std::map<std::string, Factory>& registry() {
       {"tyre_rl", factory<TyreVerticalModel>(std::string("rl"))},
       {"tyre_rr", factory<TyreVerticalModel>(std::string("rr"))},
       {"clutch_slip", factory<ClutchSlipModel>()},
+      {"clutch_torque_curve", factory<ClutchTorqueCurveModel>()},
       {"locked_driveline", factory<LockedDrivelineModel>()}};
   return r;
 }
