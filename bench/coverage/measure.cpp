@@ -111,6 +111,21 @@ car::VehicleProfile with_gear_inferred(car::VehicleProfile profile) {
   return profile;
 }
 
+// The clutch as a car without a clamp-load sensor has it (clutch_torque_curve.hpp): the same
+// launches through the actuator's travel, with the car's touch point and the clutch model's
+// masks and viscous friction.
+car::VehicleProfile with_torque_curve(car::VehicleProfile profile) {
+  ingest::ModelSpec spec = benchcar::model_spec(profile, "clutch_slip");
+  spec.model = "clutch_torque_curve";
+  spec.constants = {{"touch_point", 0.15},
+                    {"open_engagement", 0.15 + 0.85 * 150.0 / 9000.0},
+                    {"min_slip_speed", spec.constants.at("min_slip_speed")},
+                    {"stick_margin", spec.constants.at("stick_margin")}};
+  spec.effects = {"viscous_friction"};
+  profile.models.push_back(spec);
+  return profile;
+}
+
 }  // namespace
 
 double ParameterSample::relative_error() const { return (value - truth) / std::abs(truth); }
@@ -150,6 +165,9 @@ SeedRun measure_seed(const car::VehicleProfile& profile, benchcar::Manoeuvre man
     if (manoeuvre == benchcar::Manoeuvre::kLongitudinal)
       add_model(with_gear_inferred(profile), "longitudinal_engine", run, simex_seed, simex_draws,
                 r.samples, "longitudinal_engine, gear inferred");
+    if (manoeuvre == benchcar::Manoeuvre::kLaunch)
+      add_model(with_torque_curve(profile), "clutch_torque_curve", run, simex_seed, simex_draws,
+                r.samples, "clutch_torque_curve");
   } catch (const std::exception& e) {
     r.error = e.what();
   }

@@ -18,6 +18,21 @@ constexpr double kTorqueCutTime = 0.15;      // s of torque ramp-down before a s
 constexpr double kLockSlip = 0.3;            // rad/s: the launch's slip controller closes here
 constexpr double kClampApplyRate = 20000.0;  // N/s: the actuator closes the clutch in ~0.45 s
 constexpr double kClampReleaseRate = 60000.0;  // N/s: and opens it in 0.15 s
+// The clutch actuator's travel (clutch_engagement, 0 open .. 1 closed): the load is 0 up to the
+// touch point and rises linearly to kLockedClampLoad at 1 (a linear-rate spring, so that the
+// curve of clutch_torque_curve, piecewise linear, has an exact truth at its knots). Open, the
+// actuator waits at the touch point, as an automated clutch's does: a travel jumping from 0 to
+// the touch point at a launch would be smeared by the low-pass into the launch's first rows.
+constexpr double kTouchPoint = 0.15;
+// A launch's clutch torque, N m, and the factors of successive launches: a driver's launches
+// differ, and only launches that differ tell the clutch's slip-proportional friction from its
+// engagement curve (clutch_torque_curve.hpp).
+constexpr double kLaunchTorque = 230.0;
+constexpr std::array<double, 5> kLaunchTorqueFactors{1.0, 0.8, 1.2, 0.9, 1.1};
+
+double engagement_of(double clamp_load) {
+  return kTouchPoint + (1.0 - kTouchPoint) * std::max(clamp_load, 0.0) / kLockedClampLoad;
+}
 
 double smoothstep(double x) {
   x = std::clamp(x, 0.0, 1.0);
@@ -105,6 +120,8 @@ Truth make_truth(const std::vector<double>& time, const std::vector<Sample>& s) 
   put("gear", &Sample::gear);
   put("gear_ratio", &Sample::gear_ratio);
   put("clutch_clamp_load", &Sample::clamp_load);
+  std::vector<double>& travel = t["clutch_engagement"];
+  for (const Sample& x : s) travel.push_back(engagement_of(x.clamp_load));
   put("wheel_torque", &Sample::wheel_torque);
   put("brake_pressure", &Sample::brake_pressure);
   return t;
@@ -266,7 +283,9 @@ class Driveline {
       case Mode::kLaunch: {
         const double G = car_.gear_ratio(1);
         const double tau = t - launch_start_;
-        auto clutch_torque_at = [&](double tt) { return 230.0 * smoothstep((tt - launch_start_) / 0.6); };
+        auto clutch_torque_at = [&](double tt) {
+          return launch_torque_ * smoothstep((tt - launch_start_) / 0.6);
+        };
         const double clutch_torque = clutch_torque_at(t);
         // The clutch torque at each RK4 stage's own time: held over the step, the car's speed
         // would follow the torque half a step late, and the engine's recorded torque (with a0 at
@@ -343,6 +362,8 @@ class Driveline {
     mode_ = Mode::kLaunch;
     launch_start_ = t;
     launch_slip0_ = we_;  // the engine at idle, the input shaft standing
+    launch_torque_ =
+        kLaunchTorque * kLaunchTorqueFactors[launches_++ % kLaunchTorqueFactors.size()];
     stopped_ = false;
   }
 
@@ -362,7 +383,8 @@ class Driveline {
   double last_sign_ = 0.0;
   bool stopped_ = false;
   double stop_time_ = 0.0;
-  double launch_start_ = 0.0, launch_slip0_ = 0.0;
+  double launch_start_ = 0.0, launch_slip0_ = 0.0, launch_torque_ = kLaunchTorque;
+  std::size_t launches_ = 0;
   double energy_ = 0.0;
   double input_ = 0.0;  // rad/s, the free input shaft in neutral
   double clamp_ = kLockedClampLoad;  // N, the actuator's load
@@ -481,6 +503,15 @@ Truth launch(const CarParameters& car, const Perturbation& p, std::uint64_t /*se
   truth.parameters = {{"engine_inertia", car.engine_inertia},
                       {"coulomb_friction", car.clutch_mu_coulomb},
                       {"viscous_friction", car.clutch_mu_viscous}};
+  // clutch_torque_curve with the car's touch point and 4 knots (0.3625, 0.575, 0.7875, 1): the
+  // launches' loads (up to ~4 kN, engagement ~0.55) reach the first two; the others have no slip.
+  for (int j = 1; j <= 2; ++j) {
+    const double load = kLockedClampLoad * (j / 4.0);  // at knot j, (e_j - tp) / (1 - tp) = j / 4
+    truth.parameters["clutch_torque_" + std::to_string(j)] =
+        car.clutch_mu_coulomb * car.clutch_radius * load;
+    truth.parameters["clutch_viscous_" + std::to_string(j)] =
+        car.clutch_mu_viscous * car.clutch_radius * load;
+  }
   return truth;
 }
 

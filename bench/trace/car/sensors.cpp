@@ -42,6 +42,7 @@ const std::vector<SensorSpec>& sensor_set() {
       {"gear", "TRN_Status", {"GearAct"}, 1.0, 0.0},
       {"gear_ratio", "TRN_Status", {"GearRatioTot"}, 1.0, 0.0},
       {"clutch_clamp_load", "CLU_Actuator", {"ClmpLoad"}, 1e-3, 20.0},
+      {"clutch_engagement", "CLU_Actuator", {"ClutchPos"}, 1.0, 0.002, true},
       {"brake_pressure", "BRK_Press", {"MstCylPrs"}, 1e-3, 3000.0},
   };
   return set;
@@ -50,6 +51,9 @@ const std::vector<SensorSpec>& sensor_set() {
 std::size_t write_can_log(const std::filesystem::path& path, const can::Database& dbc, const Truth& truth,
                           const Perturbation& p, const BusOptions& options) {
   std::mt19937_64 rng(options.seed * 2654435761ULL + 17);
+  // The own_stream sensors' noise (a distribution of its own too: one keeps a spare draw).
+  std::mt19937_64 own_rng(options.seed * 2654435761ULL + 29);
+  std::normal_distribution<double> own_normal(0.0, 1.0);
   std::normal_distribution<double> normal(0.0, 1.0);
   // The messages in DBC order, each with its sensors.
   struct Out {
@@ -99,7 +103,10 @@ std::size_t write_can_log(const std::filesystem::path& path, const can::Database
         const double sigma = options.noise_scale * s->noise / std::sqrt(static_cast<double>(s->signals.size()));
         for (const std::string& name : s->signals) {
           const double sign = options.mirrored ? -1.0 : 1.0;
-          double v = per_signal + (sigma > 0.0 ? sign * sigma * normal(rng) : 0.0);
+          double v =
+              per_signal + (sigma > 0.0
+                                ? sign * sigma * (s->own_stream ? own_normal(own_rng) : normal(rng))
+                                : 0.0);
           // Toothed-wheel speed sensors read a standing shaft as exactly 0, without noise, and
           // never a negative speed (a slow shaft's noise would otherwise leave the DBC's range).
           if (s->channel == "engine_speed" || s->channel == "gearbox_input_speed")

@@ -22,6 +22,9 @@ struct SensorSpec {
   std::vector<std::string> signals;  ///< the SI value is split evenly over these (their sum)
   double to_dbc = 1.0;   ///< SI -> DBC physical unit
   double noise = 0.0;    ///< white-noise std of the channel at its message rate, SI
+  /// Its noise from a stream of its own: a sensor added to the set leaves the others' noise, and
+  /// so the benchmark's runs per seed, as they were.
+  bool own_stream = false;
 };
 
 /// The sensor set of benchcar.toml (one entry per channel of the profile).
