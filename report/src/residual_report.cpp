@@ -146,7 +146,8 @@ std::string by_estimator(const std::string& model, const std::string& estimator)
 }  // namespace
 
 std::string format_consistency_text(const residual::Consistency& c, const std::vector<std::string>& left_out) {
-  std::string out;
+  // The answer first, one finding per line; the comparisons after it are the evidence.
+  std::string out = wrap_clauses("consistency: ", c.statement(), 2);
   if (!c.comparisons.empty())
     out += fmt::format("{:<22} {:<22} {:>14} {:>10} {:<22} {:>14} {:>10} {:>7}\n", "parameter", "model", "value", "std",
                        "against", "value", "std", "z");
@@ -160,9 +161,9 @@ std::string format_consistency_text(const residual::Consistency& c, const std::v
   if (!c.comparisons.empty())
     out += fmt::format("(* beyond the level {:.2g}: family error rate 1 % over {} comparisons; std are HAC)\n", c.level,
                        c.tests);
-  for (const std::string& n : c.not_compared) out += "not compared: " + n + "\n";
-  for (const std::string& l : left_out) out += "left out: " + l + "\n";
-  return out + "consistency: " + c.statement() + "\n";
+  for (const std::string& n : c.not_compared) out += wrap_text("not compared: ", n, 4);
+  for (const std::string& l : left_out) out += wrap_text("left out: ", l, 4);
+  return out;
 }
 
 std::string format_trace_text(const residual::Trace& t) {

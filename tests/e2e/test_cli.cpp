@@ -1,6 +1,8 @@
 // (d) The dynid executable against a running server: `dynid estimates --vehicle V` prints the
 // table (parameter, unit, value, std, relative std %, status; rows, sigma, cond, residual RMS),
 // the other commands answer, and without a server it says so within its timeout.
+#include <gtest/gtest-spi.h>
+
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -148,6 +150,64 @@ TEST(E2eCli, AnEmptyServerSaysItIsEmpty) {
   EXPECT_EQ(text.out, "no vehicles yet: a car's first run announces its vehicle\n") << text.err;
   const auto json = dynid({"--json", "vehicles"});
   EXPECT_EQ(json.out, "[]\n") << json.err;
+}
+
+// CLI11's help, one program or subcommand: every option, positional and subcommand has a
+// description (on its line, or on the next when the name and type fill the column), and an option
+// about a count or a duration is typed as a number. Returns the subcommands' names.
+std::vector<std::string> expect_help_explains(const std::string& program, const std::string& help) {
+  std::vector<std::string> subcommands;
+  std::istringstream in(help);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  std::string section;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const std::string& line = lines[i];
+    if (!line.empty() && line.back() == ':' && line.front() != ' ') section = line;
+    if (line.rfind("  ", 0) != 0 || line.rfind("   ", 0) == 0) continue;  // entries: 2 spaces in
+    // CLI11 starts a description at column 30 (kColumn), or on the next line past it.
+    constexpr std::size_t kColumn = 30;
+    const bool described_here =
+        line.size() > kColumn && line[kColumn - 1] == ' ' && line[kColumn] != ' ';
+    const bool described_next = i + 1 < lines.size() &&
+                                lines[i + 1].rfind(std::string(20, ' '), 0) == 0 &&
+                                lines[i + 1].find_first_not_of(' ') != std::string::npos;
+    EXPECT_TRUE(described_here || described_next)
+        << program << ": no help text for `" << line << "`";
+    const std::string description = described_here ? line : (described_next ? lines[i + 1] : "");
+    if (section == "Options:" && std::regex_search(line, std::regex("^  --\\S+ TEXT\\b")))
+      EXPECT_FALSE(std::regex_search(description, std::regex("\\b(seconds|how many|number of)\\b")))
+          << program << ": `" << line << "` takes a number but is typed TEXT";
+    if (section == "Subcommands:") subcommands.push_back(line.substr(2, line.find(' ', 2) - 2));
+  }
+  return subcommands;
+}
+
+// The CLI explains itself: every subcommand's and option's help, the option types, and the one
+// environment variable for the DDS configuration in all three programs.
+TEST(E2eCli, EveryOptionAndSubcommandIsExplained) {
+  // The check itself fails on an option without help and on a duration typed as text.
+  EXPECT_NONFATAL_FAILURE(expect_help_explains("x", "Options:\n  --bare TEXT\n"), "no help text");
+  EXPECT_NONFATAL_FAILURE(
+      expect_help_explains("x", "Options:\n  --wait TEXT                 seconds to wait\n"),
+      "typed TEXT");
+  const auto top = run_command({DYNID_CLI_EXE, "--help"}, 10s);
+  ASSERT_EQ(top.exit_code, 0) << top.err;
+  const std::vector<std::string> subcommands = expect_help_explains("dynid", top.out);
+  EXPECT_GE(subcommands.size(), 20u) << top.out;
+  for (const std::string& sub : subcommands) {
+    const auto help = run_command({DYNID_CLI_EXE, sub, "--help"}, 10s);
+    ASSERT_EQ(help.exit_code, 0) << sub << ": " << help.err;
+    expect_help_explains("dynid " + sub, help.out);
+  }
+  const auto trace = run_command({DYNID_CLI_EXE, "trace", "--help"}, 10s);
+  EXPECT_TRUE(std::regex_search(trace.out, std::regex("--rounds INT"))) << trace.out;
+  for (const std::string exe : {DYNID_CLI_EXE, DYNID_SERVER_EXE, DYNID_CAR_EXE}) {
+    const auto help = run_command({exe, "--help"}, 10s);
+    ASSERT_EQ(help.exit_code, 0) << exe << ": " << help.err;
+    if (exe != DYNID_CLI_EXE) expect_help_explains(exe, help.out);
+    EXPECT_NE(help.out.find("DYNID_CYCLONE_CONFIG"), std::string::npos) << exe << "\n" << help.out;
+  }
 }
 
 // The catalogue is answered without a server or a DDS configuration, from the models' own code:

@@ -33,9 +33,10 @@ std::string format_diagnosis_text(const residual::Diagnosis& diagnosis, std::siz
 /// table) and why it stopped.
 std::string format_trace_text(const residual::Trace& trace);
 
-/// The consistency check of a run's models (dynid consistency): every comparison (parameter,
-/// the two sides with their HAC std, z, significant), the scale findings, the statement, and the
-/// models left out with the reason.
+/// The consistency check of a run's models (dynid consistency): first the answer (consistent, or
+/// each scale finding on its own line), then every comparison (parameter, the two sides with
+/// their HAC std, z, significant), and the parameters not compared and the models left out with
+/// the reason; no line but the table's wider than text_wrap.hpp's width.
 std::string format_consistency_text(const residual::Consistency& consistency, const std::vector<std::string>& left_out);
 
 /// The same as JSON objects, for tools (nlohmann::json; NaN and infinities as null). The added
