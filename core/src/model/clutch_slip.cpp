@@ -21,9 +21,7 @@ ClutchSlipModel::ClutchSlipModel(const Constants& constants) {
   min_slip_ = c.positive_or("min_slip_speed", 1e-3);
   clamp_load_zero_ = c.optional("clutch_clamp_load_zero").value_or(0.0);
   open_clamp_load_ = c.optional("open_clamp_load").value_or(0.0);
-  stick_margin_ = c.optional("stick_margin").value_or(0.0);
-  // A negative margin is an error: positive() throws naming the constant.
-  if (stick_margin_ < 0.0) stick_margin_ = c.positive("stick_margin", "s, >= 0");
+  stick_margin_ = detail::optional_margin(c, "stick_margin");
 }
 
 Eigen::Index ClutchSlipModel::margin_samples(double sample_period) const {

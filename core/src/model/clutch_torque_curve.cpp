@@ -44,8 +44,7 @@ ClutchTorqueCurveModel::ClutchTorqueCurveModel(const Constants& constants) {
   for (int j = 1; j <= n; ++j) knots_.push_back(touch_point_ + (1.0 - touch_point_) * j / n);
   knots_.back() = 1.0;
   min_slip_ = c.positive_or("min_slip_speed", 1e-3);
-  stick_margin_ = c.optional("stick_margin").value_or(0.0);
-  if (stick_margin_ < 0.0) stick_margin_ = c.positive("stick_margin", "s, >= 0");
+  stick_margin_ = detail::optional_margin(c, "stick_margin");
 }
 
 std::vector<double> ClutchTorqueCurveModel::basis(double e) const {

@@ -22,9 +22,8 @@ LateralBicycleModel::LateralBicycleModel(const Constants& constants) {
   imu_x_ = c.optional("imu_x").value_or(0.0);
   min_speed_ = c.positive_or("min_speed", 1.0);
   gravity_ = c.positive_or("gravity", detail::kStandardGravity);
-  brake_threshold_ = c.positive_or("brake_pressure_threshold", 2e4);
-  brake_margin_ = c.optional("brake_margin").value_or(0.0);
-  if (brake_margin_ < 0.0) brake_margin_ = c.positive("brake_margin", "s, >= 0");
+  brake_threshold_ = detail::brake_pressure_threshold(c);
+  brake_margin_ = detail::optional_margin(c, "brake_margin");
 }
 
 ParameterInfo LateralBicycleModel::scaled(ParameterInfo p) const {
@@ -154,9 +153,8 @@ RowModel::RowFn LateralBicycleModel::bind(const ChannelSet& set,
   const double scale = mass_.value_or(1.0);
   // Braking rows and those within brake_margin of one (the header says why; the low-pass spreads
   // the brake force's step as in the longitudinal model).
-  const std::vector<bool> braking = detail::within_margin_of(
-      set.samples(), detail::margin_samples(brake_margin_, set.sample_period()),
-      detail::braking(set, brake_threshold_, false));
+  const std::vector<bool> braking =
+      detail::near_braking(set, brake_threshold_, brake_margin_, false);
   return [=, this, &vx, &dr, ay = road_plane_ay(set), s = slip(set)](
              Eigen::Index k, std::size_t group, double* w, double& y) {
     if (vx(k) < min_speed_ || braking[static_cast<std::size_t>(k)]) return false;

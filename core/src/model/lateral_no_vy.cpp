@@ -18,9 +18,8 @@ LateralNoVyModel::LateralNoVyModel(const Constants& constants) {
   mass_ = c.optional("mass");
   if (mass_) mass_ = c.positive("mass", "kg, known vehicle mass");
   min_speed_ = c.positive_or("min_speed", 1.0);
-  brake_threshold_ = c.positive_or("brake_pressure_threshold", 2e4);
-  brake_margin_ = c.optional("brake_margin").value_or(0.0);
-  if (brake_margin_ < 0.0) brake_margin_ = c.positive("brake_margin", "s, >= 0");
+  brake_threshold_ = detail::brake_pressure_threshold(c);
+  brake_margin_ = detail::optional_margin(c, "brake_margin");
 }
 
 ParameterInfo LateralNoVyModel::scaled(ParameterInfo p) const {
@@ -67,9 +66,8 @@ RowModel::RowFn LateralNoVyModel::bind(const ChannelSet& set,
   const Eigen::VectorXd& steer = set["steer"];
   const Eigen::VectorXd& dsteer = set["d_steer"];
   const double scale = mass_.value_or(1.0);
-  const std::vector<bool> braking = detail::within_margin_of(
-      set.samples(), detail::margin_samples(brake_margin_, set.sample_period()),
-      detail::braking(set, brake_threshold_, false));
+  const std::vector<bool> braking =
+      detail::near_braking(set, brake_threshold_, brake_margin_, false);
   return [=, this, &vx, &dvx, &ay, &day, &r, &dr, &steer, &dsteer](
              Eigen::Index k, std::size_t group, double* w, double& y) {
     if (vx(k) < min_speed_ || braking[static_cast<std::size_t>(k)]) return false;

@@ -21,7 +21,7 @@ LockedDrivelineModel::LockedDrivelineModel(const Constants& constants) {
                      " is not an integer");
   gear_ = std::lround(gear);
   slip_tolerance_ = c.positive_or("lock_slip_tolerance", 1.0);
-  brake_threshold_ = c.positive_or("brake_pressure_threshold", 2e4);
+  brake_threshold_ = detail::brake_pressure_threshold(c);
 }
 
 std::vector<ParameterInfo> LockedDrivelineModel::parameters() const {

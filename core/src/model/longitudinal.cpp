@@ -27,13 +27,10 @@ LongitudinalModel::LongitudinalModel(const Constants& constants, Source source) 
   }
   gravity_ = c.positive_or("gravity", detail::kStandardGravity);
   min_speed_ = c.positive_or("min_speed", 1.0);
-  brake_threshold_ = c.positive_or("brake_pressure_threshold", 2e4);
+  brake_threshold_ = detail::brake_pressure_threshold(c);
   slip_tolerance_ = c.positive_or("clutch_slip_tolerance", 1.0);
-  slip_margin_ = c.optional("clutch_slip_margin").value_or(0.0);
-  // A negative margin is an error: positive() throws naming the constant.
-  if (slip_margin_ < 0.0) slip_margin_ = c.positive("clutch_slip_margin", "s, >= 0");
-  brake_margin_ = c.optional("brake_margin").value_or(0.0);
-  if (brake_margin_ < 0.0) brake_margin_ = c.positive("brake_margin", "s, >= 0");
+  slip_margin_ = detail::optional_margin(c, "clutch_slip_margin");
+  brake_margin_ = detail::optional_margin(c, "brake_margin");
   wheel_torque_zero_ = c.optional("wheel_torque_zero").value_or(0.0);
   if (source_ == Source::kEngineTorque) read_gear_ratios(c);
 }
@@ -253,11 +250,8 @@ RowModel::RowFn LongitudinalModel::bind(const ChannelSet& set,
                                  !(gear != nullptr && std::lround((*gear)(k)) == 0));
                        })
                  : std::vector<bool>{};
-  // Braking rows, and those within brake_margin of one (the low-pass spreads the brake force's
-  // step over its impulse response, into rows whose own filtered pressure is below the threshold).
-  const std::vector<bool> braking =
-      detail::within_margin_of(set.samples(), detail::margin_samples(brake_margin_, set.sample_period()),
-                               detail::braking(set, brake_threshold_, enabled(effects, effect::kBrakeDrag)));
+  const std::vector<bool> braking = detail::near_braking(set, brake_threshold_, brake_margin_,
+                                                         enabled(effects, effect::kBrakeDrag));
   const double half_rho = 0.5 * air_density_;
   return [=, this, &vx, &dvx, drive = drive(set)](Eigen::Index k, std::size_t, double* w,
                                                    double& y) {

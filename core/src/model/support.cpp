@@ -87,6 +87,22 @@ Eigen::Index margin_samples(double margin_s, double sample_period) {
   return static_cast<Eigen::Index>(std::ceil(margin_s / sample_period - 1e-9));
 }
 
+double optional_margin(const ConstantReader& c, const std::string& name) {
+  const double margin = c.optional(name).value_or(0.0);
+  // A negative margin is an error: positive() throws naming the constant.
+  return margin < 0.0 ? c.positive(name, "s, >= 0") : margin;
+}
+
+double brake_pressure_threshold(const ConstantReader& c) {
+  return c.positive_or("brake_pressure_threshold", 2e4);
+}
+
+std::vector<bool> near_braking(const ChannelSet& set, double threshold, double margin_s,
+                               bool allowed) {
+  return within_margin_of(set.samples(), margin_samples(margin_s, set.sample_period()),
+                          braking(set, threshold, allowed));
+}
+
 RowReach widened(RowReach r, double margin_s, double sample_period) {
   const Eigen::Index margin = margin_samples(margin_s, sample_period);
   r.back = std::max(r.back, margin);

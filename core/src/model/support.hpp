@@ -6,6 +6,7 @@
 #include <string>
 
 #include "dynid/model/channel_set.hpp"
+#include "dynid/model/constants.hpp"
 #include "dynid/model/row_model.hpp"
 
 namespace dynid::model::detail {
@@ -117,6 +118,19 @@ std::vector<bool> within_margin_of(Eigen::Index samples, Eigen::Index margin,
 
 /// A margin in seconds as whole samples at `sample_period` (rounded up).
 Eigen::Index margin_samples(double margin_s, double sample_period);
+
+/// An optional margin `name` in seconds, 0 when absent; InputError naming it when negative.
+double optional_margin(const ConstantReader& c, const std::string& name);
+
+/// The optional constant brake_pressure_threshold (Pa, 2e4 = 0.2 bar): above it a row counts as
+/// braking, for every model that leaves braking rows out.
+double brake_pressure_threshold(const ConstantReader& c);
+
+/// Per sample: braking (braking(set, threshold, allowed)) or within `margin_s` of it. Why the
+/// margin: the low-pass spreads the brake force's step over its impulse response, into rows
+/// whose own filtered pressure is below the threshold.
+std::vector<bool> near_braking(const ChannelSet& set, double threshold, double margin_s,
+                               bool allowed);
 
 /// `r` widened to read `margin_s` on both sides of a row: a model whose mask looks that far
 /// (near_stick, braking) says so, so that a streaming caller keeps that much context.
