@@ -175,9 +175,10 @@ std::vector<std::string> expect_help_explains(const std::string& program, const 
     EXPECT_TRUE(described_here || described_next)
         << program << ": no help text for `" << line << "`";
     const std::string description = described_here ? line : (described_next ? lines[i + 1] : "");
-    if (section == "Options:" && std::regex_search(line, std::regex("^  --\\S+ TEXT\\b")))
+    if (section == "Options:" && std::regex_search(line, std::regex("^  --\\S+ TEXT\\b"))) {
       EXPECT_FALSE(std::regex_search(description, std::regex("\\b(seconds|how many|number of)\\b")))
           << program << ": `" << line << "` takes a number but is typed TEXT";
+    }
     if (section == "Subcommands:") subcommands.push_back(line.substr(2, line.find(' ', 2) - 2));
   }
   return subcommands;

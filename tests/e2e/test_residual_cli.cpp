@@ -168,7 +168,9 @@ TEST(E2eResidualCli, DiagnosesAndTracesInTextAndJson) {
     for (std::string line; std::getline(lines, line);) {
       if (line.rfind("parameter ", 0) == 0) in_table = true;
       if (line.rfind("(* beyond", 0) == 0) in_table = false;
-      if (!in_table) EXPECT_LE(line.size(), 100u) << line;
+      if (!in_table) {
+        EXPECT_LE(line.size(), 100u) << line;
+      }
     }
   }
   args.push_back("--json");

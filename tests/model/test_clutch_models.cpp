@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 
 #include "dynid/error.hpp"
@@ -359,6 +360,8 @@ TEST(ClutchTorqueCurve, TheBasisIsZeroWhenOpenAndSumsToOneWhenClosing) {
     const std::vector<double> phi = m.basis(e);
     EXPECT_NEAR(phi[0] + phi[1] + phi[2], 1.0, 1e-15) << e;
   }
+  for (const double phi : m.basis(std::numeric_limits<double>::quiet_NaN()))
+    EXPECT_TRUE(std::isnan(phi));
   // Between the touch point and the first knot the curve rises from 0.
   EXPECT_NEAR(m.basis(0.25)[0], 0.5, 1e-12);
 }

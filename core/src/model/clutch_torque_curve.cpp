@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "dynid/error.hpp"
 #include "dynid/model/effects.hpp"
@@ -48,6 +49,9 @@ ClutchTorqueCurveModel::ClutchTorqueCurveModel(const Constants& constants) {
 }
 
 std::vector<double> ClutchTorqueCurveModel::basis(double e) const {
+  // A NaN travel gives NaN columns, which RowModel refuses naming the sample (no knot to index).
+  if (std::isnan(e))
+    return std::vector<double>(knots_.size(), std::numeric_limits<double>::quiet_NaN());
   std::vector<double> phi(knots_.size(), 0.0);
   if (open(e)) return phi;
   if (e >= knots_.back()) {
