@@ -112,15 +112,17 @@ car::VehicleProfile with_gear_inferred(car::VehicleProfile profile) {
 }
 
 // The clutch as a car without a clamp-load sensor has it (clutch_torque_curve.hpp): the same
-// launches through the actuator's travel, with the car's touch point and the clutch model's
-// masks and viscous friction.
+// launches through the actuator's travel, with the car's touch point, the clutch model's masks
+// and viscous friction, and open_engagement at the travel of its open_clamp_load.
 car::VehicleProfile with_torque_curve(car::VehicleProfile profile) {
+  const benchcar::CarParameters car;
   ingest::ModelSpec spec = benchcar::model_spec(profile, "clutch_slip");
   spec.model = "clutch_torque_curve";
-  spec.constants = {{"touch_point", 0.15},
-                    {"open_engagement", 0.15 + 0.85 * 150.0 / 9000.0},
-                    {"min_slip_speed", spec.constants.at("min_slip_speed")},
-                    {"stick_margin", spec.constants.at("stick_margin")}};
+  spec.constants = {
+      {"touch_point", car.clutch_touch_point},
+      {"open_engagement", car.clutch_engagement(spec.constants.at("open_clamp_load"))},
+      {"min_slip_speed", spec.constants.at("min_slip_speed")},
+      {"stick_margin", spec.constants.at("stick_margin")}};
   spec.effects = {"viscous_friction"};
   profile.models.push_back(spec);
   return profile;

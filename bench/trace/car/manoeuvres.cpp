@@ -11,28 +11,23 @@ namespace {
 
 constexpr double kDt = 1e-3;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
-constexpr double kLockedClampLoad = 9000.0;  // N, the diaphragm spring's full load
+constexpr double kLockedClampLoad = CarParameters{}.clutch_full_load;  // N
 constexpr double kUpshiftSpeed = 377.0;      // rad/s (3600 rpm)
 constexpr double kShiftTime = 0.35;          // s with the clutch open
 constexpr double kTorqueCutTime = 0.15;      // s of torque ramp-down before a shift
 constexpr double kLockSlip = 0.3;            // rad/s: the launch's slip controller closes here
 constexpr double kClampApplyRate = 20000.0;  // N/s: the actuator closes the clutch in ~0.45 s
 constexpr double kClampReleaseRate = 60000.0;  // N/s: and opens it in 0.15 s
-// The clutch actuator's travel (clutch_engagement, 0 open .. 1 closed): the load is 0 up to the
-// touch point and rises linearly to kLockedClampLoad at 1 (a linear-rate spring, so that the
-// curve of clutch_torque_curve, piecewise linear, has an exact truth at its knots). Open, the
-// actuator waits at the touch point, as an automated clutch's does: a travel jumping from 0 to
-// the touch point at a launch would be smeared by the low-pass into the launch's first rows.
-constexpr double kTouchPoint = 0.15;
+// The clutch actuator's travel (CarParameters::clutch_engagement) is linear in the load (a
+// linear-rate spring, so that the curve of clutch_torque_curve, piecewise linear, has an exact
+// truth at its knots). Open, the actuator waits at the touch point, as an automated clutch's
+// does: a travel jumping from 0 to the touch point at a launch would be smeared by the low-pass
+// into the launch's first rows.
 // A launch's clutch torque, N m, and the factors of successive launches: a driver's launches
 // differ, and only launches that differ tell the clutch's slip-proportional friction from its
 // engagement curve (clutch_torque_curve.hpp).
 constexpr double kLaunchTorque = 230.0;
 constexpr std::array<double, 5> kLaunchTorqueFactors{1.0, 0.8, 1.2, 0.9, 1.1};
-
-double engagement_of(double clamp_load) {
-  return kTouchPoint + (1.0 - kTouchPoint) * std::max(clamp_load, 0.0) / kLockedClampLoad;
-}
 
 double smoothstep(double x) {
   x = std::clamp(x, 0.0, 1.0);
@@ -121,7 +116,7 @@ Truth make_truth(const std::vector<double>& time, const std::vector<Sample>& s) 
   put("gear_ratio", &Sample::gear_ratio);
   put("clutch_clamp_load", &Sample::clamp_load);
   std::vector<double>& travel = t["clutch_engagement"];
-  for (const Sample& x : s) travel.push_back(engagement_of(x.clamp_load));
+  for (const Sample& x : s) travel.push_back(CarParameters{}.clutch_engagement(x.clamp_load));
   put("wheel_torque", &Sample::wheel_torque);
   put("brake_pressure", &Sample::brake_pressure);
   return t;

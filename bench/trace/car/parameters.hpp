@@ -34,6 +34,14 @@ struct CarParameters {
   double clutch_radius = 0.24;     // m, equivalent radius x two faces
   double clutch_mu_coulomb = 0.29;
   double clutch_mu_viscous = -3.0e-4;  // s/rad: the facing's mu falls slightly with slip
+  // The actuator's travel (clutch_engagement, 0 open .. 1 closed): the load is 0 up to the touch
+  // point and rises linearly to the diaphragm spring's full load at 1.
+  double clutch_full_load = 9000.0;  // N
+  double clutch_touch_point = 0.15;
+  double clutch_engagement(double clamp_load) const {
+    return clutch_touch_point +
+           (1.0 - clutch_touch_point) * (clamp_load > 0.0 ? clamp_load : 0.0) / clutch_full_load;
+  }
 
   double gear_ratio(int gear) const { return gear <= 0 ? 0.0 : gearbox[static_cast<unsigned>(gear - 1)] * final_drive; }
 };
