@@ -50,7 +50,16 @@ bool RequestClient::exchange(const std::string& kind, const std::vector<dds::Req
     return std::max(std::chrono::milliseconds(0),
                     std::chrono::duration_cast<std::chrono::milliseconds>(deadline - clock::now()));
   };
-  if (!requests_.wait_for_readers(1, left()) || !replies_.wait_for_writers(1, left()))
+  // In slices of at most 250 ms, so that a stop signal ends the wait within one (as below).
+  const auto matched = [&](const auto& wait_slice) {
+    for (;;) {
+      if (wait_slice(std::min(left(), std::chrono::milliseconds(250)))) return true;
+      throw_if_interrupted();
+      if (left().count() == 0) return false;
+    }
+  };
+  if (!matched([&](std::chrono::milliseconds s) { return requests_.wait_for_readers(1, s); }) ||
+      !matched([&](std::chrono::milliseconds s) { return replies_.wait_for_writers(1, s); }))
     throw NoServer("no dynid-server found within " + std::to_string(timeout.count()) +
                    " ms (is one running on this DDS domain with the same Cyclone configuration?)");
   const dds::Request request{client_id_, next_correlation_++, kind, arguments};

@@ -1,0 +1,286 @@
+// dynid-dashboard in a real browser (label browser): headless Chromium driven over the DevTools
+// protocol (--remote-debugging-pipe) opens a model's page while a run streams into an
+// in-process server; the page's rows, value and ±2σ band are read from the DOM twice, and must
+// have moved without a reload. Without the token nothing but a 401 comes back. Screenshots of the
+// fleet and of the model's page are written to the build tree (dashboard-screenshots/).
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <regex>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "child_process.hpp"
+#include "e2e_fixture.hpp"
+
+// After Eigen (e2e_fixture.hpp): httplib.h brings glibc's `_res` macro.
+#include <httplib.h>
+
+extern char** environ;
+
+namespace dynid::e2e {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+constexpr const char* kToken = "dashboard-test-token-0123456789";
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+std::string chromium() {
+  for (const char* p : {"/usr/bin/chromium", "/usr/bin/chromium-browser"})
+    if (fs::exists(p)) return p;
+  return "";
+}
+
+// The dashboard as a child; its port read from its first line.
+struct Dashboard {
+  pid_t pid = -1;
+  int port = 0;
+  Dashboard(const TempDir& dir) {
+    std::ofstream(dir.file("token")) << kToken << "\n";
+    pid = test::spawn_child({DYNID_DASHBOARD_EXE, "--listen", "127.0.0.1:0", "--token-file",
+                             dir.file("token"), "--cyclone-config", loopback_config(), "--domain",
+                             std::to_string(domain()), "--poll", "0.5"},
+                            {.file = dir.file("dashboard.log")});
+    const std::regex listening("listening on http://127\\.0\\.0\\.1:([0-9]+)/");
+    for (const auto until = Clock::now() + std::chrono::seconds(30);
+         Clock::now() < until && port == 0;) {
+      std::smatch m;
+      const std::string log = read_file(dir.file("dashboard.log"));
+      if (std::regex_search(log, m, listening)) port = std::stoi(m[1]);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  }
+  ~Dashboard() {
+    if (pid > 0) {
+      kill(pid, SIGTERM);
+      int status = 0;
+      waitpid(pid, &status, 0);
+    }
+  }
+};
+
+// Headless Chromium over the DevTools protocol on a pipe: commands on its fd 3, replies and
+// events, each ended by '\0', on its fd 4.
+class Browser {
+ public:
+  explicit Browser(const std::string& profile) {
+    int to[2], from[2];
+    if (pipe2(to, O_CLOEXEC) != 0 || pipe2(from, O_CLOEXEC) != 0) throw std::runtime_error("pipe2");
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, to[0], 3);
+    posix_spawn_file_actions_adddup2(&actions, from[1], 4);
+    const int devnull = open("/dev/null", O_WRONLY | O_CLOEXEC);
+    posix_spawn_file_actions_adddup2(&actions, devnull, 2);
+    const std::string dir = "--user-data-dir=" + profile;
+    std::vector<std::string> args{chromium(),
+                                  "--headless",
+                                  "--no-sandbox",
+                                  "--disable-gpu",
+                                  "--remote-debugging-pipe",
+                                  "--window-size=1400,1000",
+                                  dir};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    if (posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ) != 0)
+      throw std::runtime_error("spawn chromium");
+    posix_spawn_file_actions_destroy(&actions);
+    close(to[0]), close(from[1]), close(devnull);
+    out_ = to[1], in_ = from[0];
+  }
+  ~Browser() {
+    close(out_), close(in_);
+    kill(pid_, SIGTERM);
+    int status = 0;
+    waitpid(pid_, &status, 0);
+  }
+
+  // One command; its result (events before it are dropped).
+  json call(const std::string& method, const json& params = json::object(),
+            const std::string& session = "") {
+    json message = {{"id", ++id_}, {"method", method}, {"params", params}};
+    if (!session.empty()) message["sessionId"] = session;
+    const std::string text = message.dump() + std::string(1, '\0');
+    if (write(out_, text.data(), text.size()) != static_cast<ssize_t>(text.size()))
+      throw std::runtime_error("write to chromium");
+    for (;;) {
+      const json reply = next();
+      if (reply.value("id", 0) != id_) continue;
+      if (reply.contains("error")) throw std::runtime_error(method + ": " + reply["error"].dump());
+      return reply["result"];
+    }
+  }
+
+ private:
+  json next() {
+    for (;;) {
+      if (const std::size_t end = buffer_.find('\0'); end != std::string::npos) {
+        json message = json::parse(buffer_.substr(0, end));
+        buffer_.erase(0, end + 1);
+        return message;
+      }
+      char chunk[65536];
+      const ssize_t n = read(in_, chunk, sizeof chunk);
+      if (n <= 0) throw std::runtime_error("chromium closed its pipe");
+      buffer_.append(chunk, static_cast<std::size_t>(n));
+    }
+  }
+  pid_t pid_ = -1;
+  int out_ = -1, in_ = -1;
+  int id_ = 0;
+  std::string buffer_;
+};
+
+// What the page shows of the model: rows, the first parameter's value, its band's path, and the
+// marker a reload would clear.
+struct PageRead {
+  long rows = -1;
+  std::string value, band;
+  bool same_document = false;
+};
+
+PageRead read_page(Browser& b, const std::string& session) {
+  const json r = b.call("Runtime.evaluate",
+                        {{"returnByValue", true},
+                         {"expression",
+                          "(() => { const rows = document.getElementById('rows');"
+                          "  const band = document.querySelector('path[id^=band-]');"
+                          "  const value = document.querySelector('td[id^=value-]');"
+                          "  return {rows: rows ? Number(rows.textContent) : -1, band: band ? "
+                          "band.getAttribute('d') : '',"
+                          "          value: value ? value.textContent : '', marker: "
+                          "window.dynidTestMarker === 7}; })()"}},
+                        session);
+  const json v = r["result"]["value"];
+  return {v.value("rows", -1L), v.value("value", ""), v.value("band", ""),
+          v.value("marker", false)};
+}
+
+template <typename Predicate>
+bool eventually(Predicate done, std::chrono::seconds patience) {
+  for (const auto until = Clock::now() + patience; Clock::now() < until;) {
+    if (done()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return done();
+}
+
+TEST(Dashboard, WithoutTheTokenEveryRouteAnswers401AndNoData) {
+  TempDir dir;
+  Dashboard dashboard(dir);
+  ASSERT_GT(dashboard.port, 0) << read_file(dir.file("dashboard.log"));
+  httplib::Client client("127.0.0.1", dashboard.port);
+  for (const char* path :
+       {"/", "/api/fleet", "/api/history?vehicle=a&run=b&model=c", "/api/run?vehicle=a", "/events",
+        "/login?token=wrong-token-of-enough-length"}) {
+    const auto res = client.Get(path);
+    ASSERT_TRUE(res) << path;
+    EXPECT_EQ(res->status, 401) << path;
+    EXPECT_EQ(res->body.find("vehicles"), std::string::npos) << path;
+    EXPECT_EQ(res->body.find("<script"), std::string::npos) << path;
+  }
+  const auto wrong =
+      client.Get("/api/fleet", {{"Authorization", "Bearer not-the-token-but-as-long-as-it"}});
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(wrong->status, 401);
+  const auto right = client.Get("/api/fleet", {{"Authorization", std::string("Bearer ") + kToken}});
+  ASSERT_TRUE(right);
+  EXPECT_EQ(right->status, 200);
+  EXPECT_TRUE(json::parse(right->body).contains("vehicles"));
+  const auto login = client.Get((std::string("/login?token=") + kToken).c_str());
+  ASSERT_TRUE(login);
+  EXPECT_EQ(login->status, 303);
+  EXPECT_NE(login->get_header_value("Set-Cookie").find("HttpOnly"), std::string::npos);
+}
+
+TEST(Dashboard, AStreamingRunsEstimatesAndBandMoveOnThePageWithoutAReload) {
+  ASSERT_FALSE(chromium().empty())
+      << "Chromium is not installed (deploy/setup.sh installs the package 'chromium')";
+  TempDir dir;
+  InProcessServer server(server_options(dir.file("store.db")));
+  Dashboard dashboard(dir);
+  ASSERT_GT(dashboard.port, 0) << read_file(dir.file("dashboard.log"));
+  const auto run = test_run("dash-car", "run-d", 31u);
+  const auto chunks = cut_run(run, 5u);
+  ASSERT_GE(chunks.size(), 6u);
+  TestCar car("dash-car");
+  car.announce(run.announcement);
+  const std::size_t third = chunks.size() / 3;
+  ASSERT_TRUE(car.deliver(chunks, 0, third));
+
+  // The first model the dashboard received: its page is opened.
+  httplib::Client client("127.0.0.1", dashboard.port);
+  const httplib::Headers auth{{"Authorization", std::string("Bearer ") + kToken}};
+  std::string model;
+  ASSERT_TRUE(eventually(
+      [&] {
+        const auto res = client.Get("/api/fleet", auth);
+        if (!res || res->status != 200) return false;
+        const json fleet = json::parse(res->body);
+        for (const json& m : fleet["models"])
+          if (m["vehicle"] == "dash-car") model = m["model"];
+        return !model.empty();
+      },
+      std::chrono::seconds(30)))
+      << "no estimate of dash-car reached the dashboard";
+
+  Browser browser(dir.file("chromium-profile"));
+  const std::string target =
+      browser.call("Target.createTarget", {{"url", "about:blank"}})["targetId"];
+  const std::string session =
+      browser.call("Target.attachToTarget", {{"targetId", target}, {"flatten", true}})["sessionId"];
+  const std::string base = "http://127.0.0.1:" + std::to_string(dashboard.port);
+  const std::string view = "%23%2Fmodel%3Fvehicle%3Ddash-car%26run%3Drun-d%26model%3D" + model;
+  browser.call("Page.navigate", {{"url", base + "/login?token=" + kToken + "&view=" + view}},
+               session);
+  PageRead first;
+  ASSERT_TRUE(eventually(
+      [&] { return (first = read_page(browser, session)).rows > 0 && !first.band.empty(); },
+      std::chrono::seconds(30)))
+      << "the model's page never showed its rows and band";
+  browser.call("Runtime.evaluate", {{"expression", "window.dynidTestMarker = 7"}}, session);
+
+  ASSERT_TRUE(car.deliver(chunks, third, chunks.size()));
+  PageRead second;
+  ASSERT_TRUE(eventually([&] { return (second = read_page(browser, session)).rows > first.rows; },
+                         std::chrono::seconds(30)))
+      << "the page's rows stayed at " << first.rows << " while the run streamed";
+  EXPECT_TRUE(second.same_document) << "the page was reloaded: its marker is gone";
+  EXPECT_NE(second.band, first.band) << "the ±2σ band did not move";
+  EXPECT_FALSE(second.value.empty());
+
+  // Screenshots to look at (the fleet, the model's page), in the build tree.
+  const fs::path shots = fs::path(DYNID_SCREENSHOT_DIR);
+  fs::create_directories(shots);
+  for (const auto& [name, hash] :
+       {std::pair<std::string, std::string>{"fleet", "%23%2F"}, {"model", view}}) {
+    const std::string file = (shots / (name + ".png")).string();
+    fs::remove(file);
+    const pid_t shot = test::spawn_child(
+        {chromium(), "--headless", "--no-sandbox", "--disable-gpu",
+         "--user-data-dir=" + dir.file("shot-profile"), "--window-size=1400,1300", "--timeout=4000",
+         "--screenshot=" + file, base + "/login?token=" + kToken + "&view=" + hash},
+        {.file = dir.file("shot.log")});
+    int status = 0;
+    waitpid(shot, &status, 0);
+    EXPECT_TRUE(fs::exists(file) && fs::file_size(file) > 10000)
+        << name << ": " << read_file(dir.file("shot.log"));
+  }
+}
+
+}  // namespace
+}  // namespace dynid::e2e
