@@ -4,6 +4,7 @@
     load_table.py table DDSPERF_SAMPLES_PER_S PAYLOAD_BYTES < results.jsonl
     load_table.py stores < results.jsonl     (run-load.sh stores: SQLite and PostgreSQL side by side)
     load_table.py soak < results.jsonl
+    load_table.py dashboards < results.jsonl  (run-load.sh dashboards: without and with dashboards)
 """
 import json
 import statistics
@@ -97,12 +98,40 @@ def soak(rows):
         print("RSS (MB) every", step, "samples:", " ".join(f"{v:.1f}" for v in series[::step]))
 
 
+def dashboards(rows):
+    """Per mode and N, the runs without dashboards beside those with (labels fast-K, paced-K),
+    and the ratio with / without of the ingest rate and of the server's CPU per row."""
+    print("| mode | N | dashboards | runs (ok) | rows/s ingested | chunk->estimate p50 / p99 ms | lost | "
+          "server CPU µs per row | rows/s, with / without | CPU per row, with / without |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for mode in ("fast", "paced"):
+        for n in sorted({r["vehicles"] for r in rows}):
+            base = None
+            for k in sorted({int(r["mode"].split("-")[1]) for r in rows if r["mode"].startswith(mode + "-")}):
+                rs = [r for r in rows if r["mode"] == f"{mode}-{k}" and r["vehicles"] == n]
+                if not rs:
+                    continue
+                ok = sum(1 for r in rs if r["status"] == 0)
+                ingest = med([r["sample_rows_acked"] / r["stream_seconds"] for r in rs if r["stream_seconds"] > 0])
+                us = med([1e6 * r["server_cpu_seconds"] / r["sample_rows_acked"] for r in rs if r["sample_rows_acked"] > 0])
+                lost = max(r["lost"] + r["missed"] for r in rs)
+                ratios = "-" if base is None else f"{ingest / base[0]:.3f}"
+                cpu_ratio = "-" if base is None else f"{us / base[1]:.3f}"
+                if base is None:
+                    base = (ingest, us)
+                print(f"| {mode} | {n} | {k} | {len(rs)} ({ok}) | {ingest:,.0f} | "
+                      f"{med([r['estimate_p50_ms'] for r in rs]):.1f} / {med([r['estimate_p99_ms'] for r in rs]):.1f} | "
+                      f"{lost} | {us:.2f} | {ratios} | {cpu_ratio} |")
+
+
 def main():
     rows = [json.loads(line) for line in sys.stdin if line.strip()]
     if sys.argv[1] == "table":
         table(rows, float(sys.argv[2]), int(sys.argv[3]))
     elif sys.argv[1] == "stores":
         stores(rows)
+    elif sys.argv[1] == "dashboards":
+        dashboards(rows)
     else:
         soak(rows)
 

@@ -16,6 +16,11 @@
 #                                         server, PostgreSQL with one and with three servers
 #                                         sharing one database), fast then paced, interleaved;
 #                                         one table of medians
+#   bash bench/load/run-load.sh dashboards  N vehicles (VEHICLES, "50") without and with DASHBOARDS
+#                                         (3) dynid-dashboard programs open, each with a browser's
+#                                         traffic on its fleet view (its event stream, /api/fleet
+#                                         every 0.3 s); REPS rounds, fast then paced, alternated;
+#                                         one table of medians, with and without side by side
 #   bash bench/load/run-load.sh cluster-smoke   three servers on PostgreSQL, 6 vehicles paced;
 #                                         the holder of some vehicles is SIGKILLed mid-run:
 #                                         every chunk acknowledged (resends needed and counted),
@@ -43,6 +48,7 @@ mode=${1:-table}
 build=${BUILD_DIR:-build-server}
 server=$build/server/dynid-server
 load=$build/bench/load/dynid-load
+dashboard=$build/client/dashboard/dynid-dashboard
 for exe in "$server" "$load"; do
   [ -x "$exe" ] || { echo "run-load: $exe is missing (cmake --build $build --target dynid-server dynid-load)" >&2; exit 2; }
 done
@@ -50,6 +56,9 @@ reps=${REPS:-3}
 if [ "$mode" = stores ]; then
   vehicles=${VEHICLES:-"10 100"}
   fast_chunks=${FAST_CHUNKS:-5000}
+elif [ "$mode" = dashboards ]; then
+  vehicles=${VEHICLES:-50}
+  fast_chunks=${FAST_CHUNKS:-10000}
 else
   vehicles=${VEHICLES:-"1 10 100 1000"}
   fast_chunks=${FAST_CHUNKS:-10000}
@@ -69,6 +78,8 @@ tag="<Discovery><Tag>dynid-load-$$</Tag></Discovery>"
 config="file://$root/deploy/cyclonedds/loopback.xml,$tag"
 domain=$((40 + $$ % 100))
 server_pids=()
+dashboard_pids=()
+dashboard_ports=()
 pg_pid=""
 pg_base=""
 pg_schemas=0
@@ -86,7 +97,27 @@ stop_postgres() {
   fi
   pg_pid=""
 }
+stop_dashboards() {
+  local pid
+  for pid in "${dashboard_pids[@]}"; do kill -TERM "$pid" 2>/dev/null || true; done
+  for pid in "${dashboard_pids[@]}"; do wait "$pid" 2>/dev/null || true; done
+  dashboard_pids=()
+  dashboard_ports=()
+}
+# What each open dashboard received: the models it shows (a dashboard that saw nothing would
+# measure nothing).
+report_dashboards() {
+  local dir=$1 port
+  for port in "${dashboard_ports[@]}"; do
+    curl -s -H "Authorization: Bearer $(cat "$dir/token")" "http://127.0.0.1:$port/api/fleet" |
+      python3 -c 'import json, sys
+f = json.load(sys.stdin)
+print("run-load: dashboard :%s shows %d vehicles, %d models, %d publications"
+      % (sys.argv[1], len(f["vehicles"]), len(f["models"]), f["sequence"]), file=sys.stderr)' "$port" || true
+  done
+}
 cleanup() {
+  stop_dashboards
   stop_servers
   stop_postgres
   if [ "${KEEP:-0}" = 1 ]; then echo "run-load: kept $work" >&2; else rm -rf "$work"; fi
@@ -151,6 +182,32 @@ start_servers() {
   done
 }
 
+# COUNT dynid-dashboard programs on the servers' domain, each with what a browser on its fleet
+# view asks: the event stream, and /api/fleet every 0.3 s (the page redraws at most that often
+# while estimates come). Their pids (the browsers' loops too) in dashboard_pids.
+start_dashboards() {
+  local count=$1 dir=$2 k port
+  [ -x "$dashboard" ] || { echo "run-load: $dashboard is missing (cmake --build $build --target dynid-dashboard)" >&2; exit 2; }
+  head -c 16 /dev/urandom | od -An -tx1 | tr -d ' \n' >"$dir/token"
+  for k in $(seq "$count"); do
+    "$dashboard" --listen 127.0.0.1:0 --token-file "$dir/token" --cyclone-config "$config" --domain "$domain" \
+      >"$dir/dashboard-$k.log" 2>&1 &
+    dashboard_pids+=($!)
+    port=""
+    for _ in $(seq 100); do
+      port=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$dir/dashboard-$k.log")
+      [ -n "$port" ] && break
+      sleep 0.1
+    done
+    [ -n "$port" ] || { echo "run-load: dashboard $k did not start:" >&2; cat "$dir/dashboard-$k.log" >&2; exit 2; }
+    dashboard_ports+=("$port")
+    curl -sN -H "Authorization: Bearer $(cat "$dir/token")" "http://127.0.0.1:$port/events" >/dev/null 2>&1 &
+    dashboard_pids+=($!)
+    (while :; do curl -s -H "Authorization: Bearer $(cat "$dir/token")" "http://127.0.0.1:$port/api/fleet" >/dev/null || true; sleep 0.3; done) &
+    dashboard_pids+=($!)
+  done
+}
+
 # Read from the store (servers stopped): "runs complete chunks", where complete counts the runs
 # holding each of their CHUNKS chunks exactly once with the ledger contiguous through the last.
 store_check() {
@@ -174,12 +231,15 @@ one_run() {
   new_store "$kind" "$dir"
   [ "$kind" = postgresql ] && db_cpu=$(pg_cpu)
   start_servers "$kind" "$count" "$store" "$dir"
+  [ "${open_dashboards:-0}" -gt 0 ] && start_dashboards "$open_dashboards" "$dir"
   for pid in "${server_pids[@]}"; do pids+=(--server-pid "$pid"); done
   local status=0
   "$load" --cyclone-config deploy/cyclonedds/loopback.xml --cyclone-fragment "$tag" \
     --domain "$domain" --servers "$count" "${pids[@]}" --chunk-rows "$chunk_rows" --rate "$rate" \
     --ack-timeout "$ack_timeout" --vehicles "$n" --chunks "$chunks" "$@" \
     >"$dir/load.json" 2>"$dir/load.err" || status=$?
+  [ "${#dashboard_ports[@]}" -gt 0 ] && report_dashboards "$dir"
+  stop_dashboards
   stop_servers
   [ "$kind" = postgresql ] && db_cpu=$(awk -v a="$db_cpu" -v b="$(pg_cpu)" 'BEGIN { printf "%.2f", b - a }')
   finish_run "$label" "$kind" "$count" "$n" "$chunks" "$dir" "$store" "$status" "$db_cpu"
@@ -300,6 +360,20 @@ case "$mode" in
     done
     python3 bench/load/load_table.py stores <"$out/results.jsonl"
     ;;
+  dashboards)
+    for n in $vehicles; do
+      for _ in $(seq "$reps"); do
+        for open_dashboards in 0 "${DASHBOARDS:-3}"; do
+          one_run "fast-$open_dashboards" sqlite 1 "$n" $(( (fast_chunks + n - 1) / n > 10 ? (fast_chunks + n - 1) / n : 10 )) \
+            --fast --window 16 --patience 120 --drain 60 || true
+          one_run "paced-$open_dashboards" sqlite 1 "$n" $(( paced_seconds * rate / chunk_rows )) \
+            --patience 120 --drain 30 || true
+        done
+      done
+    done
+    open_dashboards=0
+    python3 bench/load/load_table.py dashboards <"$out/results.jsonl"
+    ;;
   soak)
     soak_vehicles=${SOAK_VEHICLES:-100}
     soak_seconds=${SOAK_SECONDS:-600}
@@ -321,7 +395,7 @@ case "$mode" in
     python3 bench/load/load_table.py table "$dds_rate" "$dds_bytes" <"$out/results.jsonl"
     ;;
   *)
-    echo "run-load: unknown mode '$mode' (table, stores, soak, smoke, cluster-smoke)" >&2
+    echo "run-load: unknown mode '$mode' (table, stores, dashboards, soak, smoke, cluster-smoke)" >&2
     exit 2
     ;;
 esac

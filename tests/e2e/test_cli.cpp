@@ -203,7 +203,8 @@ TEST(E2eCli, EveryOptionAndSubcommandIsExplained) {
   }
   const auto trace = run_command({DYNID_CLI_EXE, "trace", "--help"}, 10s);
   EXPECT_TRUE(std::regex_search(trace.out, std::regex("--rounds INT"))) << trace.out;
-  for (const std::string exe : {DYNID_CLI_EXE, DYNID_SERVER_EXE, DYNID_CAR_EXE, DYNID_DASHBOARD_EXE}) {
+  for (const std::string exe :
+       {DYNID_CLI_EXE, DYNID_SERVER_EXE, DYNID_CAR_EXE, DYNID_DASHBOARD_EXE}) {
     const auto help = run_command({exe, "--help"}, 10s);
     ASSERT_EQ(help.exit_code, 0) << exe << ": " << help.err;
     if (exe != DYNID_CLI_EXE) expect_help_explains(exe, help.out);

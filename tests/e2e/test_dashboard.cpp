@@ -2,7 +2,7 @@
 // protocol (--remote-debugging-pipe) opens a model's page while a run streams into an
 // in-process server; the page's rows, value and ±2σ band are read from the DOM twice, and must
 // have moved without a reload. Without the token nothing but a 401 comes back. Screenshots of the
-// fleet and of the model's page are written to the build tree (dashboard-screenshots/).
+// fleet, of the run and of the model's page are written to the build tree (dashboard-screenshots/).
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -14,6 +14,7 @@
 #include <iterator>
 #include <regex>
 #include <thread>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -145,6 +146,21 @@ class Browser {
   std::string buffer_;
 };
 
+std::string base64_decode(const std::string& in) {
+  static const std::string digits =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  unsigned bits = 0;
+  int count = 0;
+  for (const char c : in) {
+    const std::size_t d = digits.find(c);
+    if (d == std::string::npos) continue;  // '=' and line breaks
+    bits = (bits << 6) | static_cast<unsigned>(d);
+    if ((count += 6) >= 8) out.push_back(static_cast<char>((bits >> (count -= 8)) & 0xFF));
+  }
+  return out;
+}
+
 // What the page shows of the model: rows, the first parameter's value, its band's path, and the
 // marker a reload would clear.
 struct PageRead {
@@ -263,22 +279,33 @@ TEST(Dashboard, AStreamingRunsEstimatesAndBandMoveOnThePageWithoutAReload) {
   EXPECT_NE(second.band, first.band) << "the ±2σ band did not move";
   EXPECT_FALSE(second.value.empty());
 
-  // Screenshots to look at (the fleet, the model's page), in the build tree.
+  // Screenshots to look at (the fleet, a run, the model's page), in the build tree, each taken
+  // once its view has drawn.
   const fs::path shots = fs::path(DYNID_SCREENSHOT_DIR);
   fs::create_directories(shots);
-  for (const auto& [name, hash] :
-       {std::pair<std::string, std::string>{"fleet", "%23%2F"}, {"model", view}}) {
-    const std::string file = (shots / (name + ".png")).string();
-    fs::remove(file);
-    const pid_t shot = test::spawn_child(
-        {chromium(), "--headless", "--no-sandbox", "--disable-gpu",
-         "--user-data-dir=" + dir.file("shot-profile"), "--window-size=1400,1300", "--timeout=4000",
-         "--screenshot=" + file, base + "/login?token=" + kToken + "&view=" + hash},
-        {.file = dir.file("shot.log")});
-    int status = 0;
-    waitpid(shot, &status, 0);
-    EXPECT_TRUE(fs::exists(file) && fs::file_size(file) > 10000)
-        << name << ": " << read_file(dir.file("shot.log"));
+  browser.call("Emulation.setDeviceMetricsOverride",
+               {{"width", 1400}, {"height", 1300}, {"deviceScaleFactor", 1}, {"mobile", false}},
+               session);
+  const std::vector<std::tuple<std::string, std::string, std::string>> views{
+      {"fleet", "#/", "#fleet-models"},
+      {"run", "#/run?vehicle=dash-car&run=run-d", "#run-health"},
+      {"model", "#/model?vehicle=dash-car&run=run-d&model=" + model, "path[id^=band-]"}};
+  for (const auto& [name, hash, drawn] : views) {
+    browser.call("Page.navigate", {{"url", base + "/" + hash}}, session);
+    const std::string ready = "document.querySelector('" + drawn + "') !== null";
+    EXPECT_TRUE(eventually(
+        [&] {
+          return browser
+              .call("Runtime.evaluate", {{"expression", ready}, {"returnByValue", true}},
+                    session)["result"]
+              .value("value", false);
+        },
+        std::chrono::seconds(20)))
+        << name << ": " << drawn << " never drawn";
+    const std::string png =
+        base64_decode(browser.call("Page.captureScreenshot", {{"format", "png"}}, session)["data"]);
+    std::ofstream((shots / (name + ".png")).string(), std::ios::binary) << png;
+    EXPECT_GT(png.size(), 10000u) << name;
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <memory>
 
 namespace dynid::dashboard {
@@ -51,7 +52,8 @@ void stream_events(const FleetState& state, const httplib::Request& req, httplib
   std::uint64_t after = state.sequence();
   if (const std::string last = req.get_header_value("Last-Event-ID"); !last.empty()) {
     try {
-      after = std::stoull(last);
+      // A number past the newest is of a dashboard that restarted since: from now on.
+      after = std::min<std::uint64_t>(after, std::stoull(last));
     } catch (const std::exception&) {  // not a number: from now on
     }
   }

@@ -44,6 +44,8 @@ using nlohmann::json;
 // A token guessed in a lifetime of tries is no credential: 16 characters at least (the
 // deployment makes 32 random hex digits: docs/DASHBOARD.md).
 constexpr std::size_t kMinTokenLength = 16;
+// Connections served at once: two per open page (its event stream and a request), with room.
+constexpr std::size_t kConnections = 64;
 
 struct Options {
   std::string listen = "127.0.0.1:8087";
@@ -235,6 +237,9 @@ int main(int argc, char** argv) {
   Servers servers(*participant,
                   std::chrono::milliseconds(static_cast<long long>(o.timeout_s * 1000)));
   httplib::Server http;
+  // A connection holds one of the pool's threads while it is open, and each browser keeps its
+  // event stream open: the library's default of 8 would let the eighth screen starve the others.
+  http.new_task_queue = [] { return new httplib::ThreadPool(kConnections); };
   dynid::dashboard::install_routes(
       http, state, token, dynid::dashboard::page(),
       [&servers](const std::string& v, const std::string& r) { return servers.run(v, r); });
