@@ -35,7 +35,8 @@
 # hold each of its chunks once and its ledger be contiguous through the last one.
 #
 # Environment: BUILD_DIR (build-server), REPS (3), VEHICLES ("1 10 100 1000"; stores: "10 100"),
-# STORES ("sqlite:1 postgresql:1 postgresql:3"), CHUNK_ROWS (100), RATE (100 Hz), FAST_CHUNKS
+# STORES ("sqlite:1 postgresql:1 postgresql:3"), DASHBOARDS (3), DASHBOARD_ARGS (extra
+# dynid-dashboard options), CHUNK_ROWS (100), RATE (100 Hz), FAST_CHUNKS
 # (total chunks of a fast run, 10000; stores: 5000), PACED_SECONDS (20), ACK_TIMEOUT (5 s,
 # dynid-car's default: dynid-load resends what is in flight after that long without an ack),
 # SERVER_ARGS (extra dynid-server options), OUT (folder for the JSON lines; a temp one),
@@ -108,6 +109,11 @@ stop_dashboards() {
 # measure nothing).
 report_dashboards() {
   local dir=$1 port
+  local pid
+  for pid in "${dashboard_pids[@]}"; do
+    awk -v hz="$(getconf CLK_TCK)" -v who="$(cat "/proc/$pid/comm" 2>/dev/null)" \
+      '{ sub(/^.*\) /, ""); printf "run-load: %s CPU %.2f s\n", who, ($12 + $13) / hz }' "/proc/$pid/stat" >&2 2>/dev/null || true
+  done
   for port in "${dashboard_ports[@]}"; do
     curl -s -H "Authorization: Bearer $(cat "$dir/token")" "http://127.0.0.1:$port/api/fleet" |
       python3 -c 'import json, sys
@@ -183,27 +189,26 @@ start_servers() {
 }
 
 # COUNT dynid-dashboard programs on the servers' domain, each with what a browser on its fleet
-# view asks: the event stream, and /api/fleet every 0.3 s (the page redraws at most that often
-# while estimates come). Their pids (the browsers' loops too) in dashboard_pids.
+# view asks (browser_traffic.py: the event stream, /api/fleet every 0.3 s, kept-alive
+# connections). Their pids (the browsers' too) in dashboard_pids, their ports in dashboard_ports.
 start_dashboards() {
   local count=$1 dir=$2 k port
   [ -x "$dashboard" ] || { echo "run-load: $dashboard is missing (cmake --build $build --target dynid-dashboard)" >&2; exit 2; }
   head -c 16 /dev/urandom | od -An -tx1 | tr -d ' \n' >"$dir/token"
   for k in $(seq "$count"); do
+    # shellcheck disable=SC2086
     "$dashboard" --listen 127.0.0.1:0 --token-file "$dir/token" --cyclone-config "$config" --domain "$domain" \
-      >"$dir/dashboard-$k.log" 2>&1 &
+      ${DASHBOARD_ARGS:-} >"$dir/dashboard-$k.log" 2>&1 &
     dashboard_pids+=($!)
     port=""
     for _ in $(seq 100); do
-      port=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$dir/dashboard-$k.log")
+      port=$(sed -n 's|.*listening on http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$dir/dashboard-$k.log" 2>/dev/null || true)
       [ -n "$port" ] && break
       sleep 0.1
     done
     [ -n "$port" ] || { echo "run-load: dashboard $k did not start:" >&2; cat "$dir/dashboard-$k.log" >&2; exit 2; }
     dashboard_ports+=("$port")
-    curl -sN -H "Authorization: Bearer $(cat "$dir/token")" "http://127.0.0.1:$port/events" >/dev/null 2>&1 &
-    dashboard_pids+=($!)
-    (while :; do curl -s -H "Authorization: Bearer $(cat "$dir/token")" "http://127.0.0.1:$port/api/fleet" >/dev/null || true; sleep 0.3; done) &
+    python3 bench/load/browser_traffic.py "$port" "$dir/token" &
     dashboard_pids+=($!)
   done
 }

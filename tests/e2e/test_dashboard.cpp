@@ -1,8 +1,9 @@
 // dynid-dashboard in a real browser (label browser): headless Chromium driven over the DevTools
-// protocol (--remote-debugging-pipe) opens a model's page while a run streams into an
-// in-process server; the page's rows, value and ±2σ band are read from the DOM twice, and must
-// have moved without a reload. Without the token nothing but a 401 comes back. Screenshots of the
-// fleet, of the run and of the model's page are written to the build tree (dashboard-screenshots/).
+// protocol (--remote-debugging-pipe) opens a model's page while dynid-car replays a simulated run
+// into an in-process server; the page's rows, value and ±2σ band are read from the DOM twice, and
+// must have moved without a reload. Without the token nothing but a 401 comes back. Screenshots of
+// the fleet, of the run and of the model's page are written to the build tree
+// (dashboard-screenshots/).
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -223,22 +224,39 @@ TEST(Dashboard, WithoutTheTokenEveryRouteAnswers401AndNoData) {
   EXPECT_NE(login->get_header_value("Set-Cookie").find("HttpOnly"), std::string::npos);
 }
 
-TEST(Dashboard, AStreamingRunsEstimatesAndBandMoveOnThePageWithoutAReload) {
+// The run of a user: the simulator's swept-sine steering run (40 s), replayed by dynid-car in real
+// time with the test car's profile into the server, the dashboard's page open on one of its models.
+TEST(Dashboard, AReplayedRunsEstimatesAndBandMoveOnThePageWithoutAReload) {
   ASSERT_FALSE(chromium().empty())
       << "Chromium is not installed (deploy/setup.sh installs the package 'chromium')";
   TempDir dir;
   InProcessServer server(server_options(dir.file("store.db")));
   Dashboard dashboard(dir);
   ASSERT_GT(dashboard.port, 0) << read_file(dir.file("dashboard.log"));
-  const auto run = test_run("dash-car", "run-d", 31u);
-  const auto chunks = cut_run(run, 5u);
-  ASSERT_GE(chunks.size(), 6u);
-  TestCar car("dash-car");
-  car.announce(run.announcement);
-  const std::size_t third = chunks.size() / 3;
-  ASSERT_TRUE(car.deliver(chunks, 0, third));
+  const std::string source = DYNID_SOURCE_DIR;
+  const pid_t sim =
+      test::spawn_child({DYNID_SIM_EXE, "--scenario", source + "/deploy/scenarios/sine_steer.toml",
+                         "--out", dir.file("run")},
+                        {.file = dir.file("sim.log")});
+  int sim_status = 0;
+  waitpid(sim, &sim_status, 0);
+  ASSERT_TRUE(WIFEXITED(sim_status) && WEXITSTATUS(sim_status) == 0)
+      << read_file(dir.file("sim.log"));
+  const pid_t car = test::spawn_child(
+      {DYNID_CAR_EXE, "--profile", source + "/deploy/profiles/testcar.toml", "--cyclone-config",
+       loopback_config(), "--domain", std::to_string(domain()), "--replay",
+       dir.file("run") + "/can.log", "--spool", dir.file("spool"), "--run", "run-d"},
+      {.file = dir.file("car.log")});
+  struct Stop {
+    pid_t pid;
+    ~Stop() {
+      kill(pid, SIGTERM);
+      int status = 0;
+      waitpid(pid, &status, 0);
+    }
+  } stop_car{car};
 
-  // The first model the dashboard received: its page is opened.
+  // A model of the replayed run the dashboard received: its page is opened.
   httplib::Client client("127.0.0.1", dashboard.port);
   const httplib::Headers auth{{"Authorization", std::string("Bearer ") + kToken}};
   std::string model;
@@ -246,21 +264,23 @@ TEST(Dashboard, AStreamingRunsEstimatesAndBandMoveOnThePageWithoutAReload) {
       [&] {
         const auto res = client.Get("/api/fleet", auth);
         if (!res || res->status != 200) return false;
-        const json fleet = json::parse(res->body);
+        const json fleet =
+            json::parse(res->body);  // kept: a range over a temporary's member dangles
         for (const json& m : fleet["models"])
-          if (m["vehicle"] == "dash-car") model = m["model"];
+          if (m["vehicle"] == "dynid-testcar" && m["model"] == "lateral_bicycle")
+            model = m["model"];
         return !model.empty();
       },
       std::chrono::seconds(30)))
-      << "no estimate of dash-car reached the dashboard";
-
+      << "no estimate of the replayed run reached the dashboard; it shows "
+      << client.Get("/api/fleet", auth)->body << "\nthe car: " << read_file(dir.file("car.log"));
   Browser browser(dir.file("chromium-profile"));
   const std::string target =
       browser.call("Target.createTarget", {{"url", "about:blank"}})["targetId"];
   const std::string session =
       browser.call("Target.attachToTarget", {{"targetId", target}, {"flatten", true}})["sessionId"];
   const std::string base = "http://127.0.0.1:" + std::to_string(dashboard.port);
-  const std::string view = "%23%2Fmodel%3Fvehicle%3Ddash-car%26run%3Drun-d%26model%3D" + model;
+  const std::string view = "%23%2Fmodel%3Fvehicle%3Ddynid-testcar%26run%3Drun-d%26model%3D" + model;
   browser.call("Page.navigate", {{"url", base + "/login?token=" + kToken + "&view=" + view}},
                session);
   PageRead first;
@@ -270,11 +290,10 @@ TEST(Dashboard, AStreamingRunsEstimatesAndBandMoveOnThePageWithoutAReload) {
       << "the model's page never showed its rows and band";
   browser.call("Runtime.evaluate", {{"expression", "window.dynidTestMarker = 7"}}, session);
 
-  ASSERT_TRUE(car.deliver(chunks, third, chunks.size()));
   PageRead second;
   ASSERT_TRUE(eventually([&] { return (second = read_page(browser, session)).rows > first.rows; },
                          std::chrono::seconds(30)))
-      << "the page's rows stayed at " << first.rows << " while the run streamed";
+      << "the page's rows stayed at " << first.rows << " while the run was replayed";
   EXPECT_TRUE(second.same_document) << "the page was reloaded: its marker is gone";
   EXPECT_NE(second.band, first.band) << "the ±2σ band did not move";
   EXPECT_FALSE(second.value.empty());
@@ -288,8 +307,8 @@ TEST(Dashboard, AStreamingRunsEstimatesAndBandMoveOnThePageWithoutAReload) {
                session);
   const std::vector<std::tuple<std::string, std::string, std::string>> views{
       {"fleet", "#/", "#fleet-models"},
-      {"run", "#/run?vehicle=dash-car&run=run-d", "#run-health"},
-      {"model", "#/model?vehicle=dash-car&run=run-d&model=" + model, "path[id^=band-]"}};
+      {"run", "#/run?vehicle=dynid-testcar&run=run-d", "#run-health"},
+      {"model", "#/model?vehicle=dynid-testcar&run=run-d&model=" + model, "path[id^=band-]"}};
   for (const auto& [name, hash, drawn] : views) {
     browser.call("Page.navigate", {{"url", base + "/" + hash}}, session);
     const std::string ready = "document.querySelector('" + drawn + "') !== null";
