@@ -46,6 +46,19 @@ std::string chromium() {
   return "";
 }
 
+// SIGTERM, then up to `patience` for the child to exit; SIGKILL after it. True if it exited.
+bool stop_within(pid_t pid, std::chrono::seconds patience) {
+  kill(pid, SIGTERM);
+  int status = 0;
+  for (const auto until = Clock::now() + patience; Clock::now() < until;) {
+    if (waitpid(pid, &status, WNOHANG) == pid) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, &status, 0);
+  return false;
+}
+
 // The dashboard as a child; its port read from its first line.
 struct Dashboard {
   pid_t pid = -1;
@@ -66,11 +79,8 @@ struct Dashboard {
     }
   }
   ~Dashboard() {
-    if (pid > 0) {
-      kill(pid, SIGTERM);
-      int status = 0;
-      waitpid(pid, &status, 0);
-    }
+    if (pid > 0 && !stop_within(pid, std::chrono::seconds(10)))
+      ADD_FAILURE() << "the dashboard did not stop within 10 s of SIGTERM (killed)";
   }
 };
 
@@ -106,9 +116,7 @@ class Browser {
   }
   ~Browser() {
     close(out_), close(in_);
-    kill(pid_, SIGTERM);
-    int status = 0;
-    waitpid(pid_, &status, 0);
+    stop_within(pid_, std::chrono::seconds(10));
   }
 
   // One command; its result (events before it are dropped).
@@ -224,6 +232,36 @@ TEST(Dashboard, WithoutTheTokenEveryRouteAnswers401AndNoData) {
   EXPECT_NE(login->get_header_value("Set-Cookie").find("HttpOnly"), std::string::npos);
 }
 
+// Exit status and output of the dashboard started with `args` (it must end by itself).
+std::pair<int, std::string> dashboard_exit(const TempDir& dir,
+                                           const std::vector<std::string>& args) {
+  std::vector<std::string> argv{DYNID_DASHBOARD_EXE, "--listen", "127.0.0.1:0"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  const std::string log = dir.file("refused.log");
+  fs::remove(log);
+  const pid_t pid = test::spawn_child(argv, {.file = log});
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(log)};
+}
+
+TEST(Dashboard, ABadTokenOrConfigurationIsRefusedWithItsReason) {
+  TempDir dir;
+  std::ofstream(dir.file("short")) << "too-short\n";
+  std::ofstream(dir.file("token")) << kToken << "\n";
+  const auto [short_status, short_out] = dashboard_exit(dir, {"--token-file", dir.file("short")});
+  EXPECT_EQ(short_status, 2);
+  EXPECT_NE(short_out.find("at least 16 characters; it has 9"), std::string::npos) << short_out;
+  const auto [missing_status, missing_out] =
+      dashboard_exit(dir, {"--token-file", dir.file("nothing")});
+  EXPECT_EQ(missing_status, 2);
+  EXPECT_NE(missing_out.find("cannot be read"), std::string::npos) << missing_out;
+  const auto [config_status, config_out] =
+      dashboard_exit(dir, {"--token-file", dir.file("token"), "--cyclone-config", "<Nonsense/>"});
+  EXPECT_EQ(config_status, 2);
+  EXPECT_NE(config_out.find("cannot join DDS"), std::string::npos) << config_out;
+}
+
 // The run of a user: the simulator's swept-sine steering run (40 s), replayed by dynid-car in real
 // time with the test car's profile into the server, the dashboard's page open on one of its models.
 TEST(Dashboard, AReplayedRunsEstimatesAndBandMoveOnThePageWithoutAReload) {
@@ -249,11 +287,7 @@ TEST(Dashboard, AReplayedRunsEstimatesAndBandMoveOnThePageWithoutAReload) {
       {.file = dir.file("car.log")});
   struct Stop {
     pid_t pid;
-    ~Stop() {
-      kill(pid, SIGTERM);
-      int status = 0;
-      waitpid(pid, &status, 0);
-    }
+    ~Stop() { stop_within(pid, std::chrono::seconds(10)); }
   } stop_car{car};
 
   // A model of the replayed run the dashboard received: its page is opened.

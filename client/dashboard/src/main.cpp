@@ -4,15 +4,19 @@
 // and a run's channel health on demand, and serves a page, its JSON and a server-sent-event
 // stream over HTTP (http_routes.hpp). It reads only; it lets in only who holds the token.
 //
-// Exit codes: 0 stopped by SIGINT or SIGTERM, 2 bad command line or token, 7 no DDS participant
-// index was free, 1 the HTTP address could not be bound.
+// Exit codes: 0 stopped by SIGINT or SIGTERM, 1 the HTTP address could not be bound, 2 bad
+// command line, token or DDS configuration, 7 no DDS participant index was free.
+#include <fcntl.h>
 #include <signal.h>
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -86,10 +90,14 @@ class Servers {
     const auto replies = client_.call_all("vehicles", {{"format", "json"}}, timeout_);
     json out = json::array();
     for (const std::string& v : dynid::cli::merged_vehicles(replies)) {
-      const dynid::dds::Reply r =
-          client_.call("runs", {{"vehicle", v}, {"format", "json"}}, timeout_);
-      json runs = r.status == dynid::dds::ReplyStatus::kOk ? json::parse(r.payload, nullptr, false)
-                                                           : json();
+      // A vehicle whose server does not answer is listed without its runs, the others with.
+      json runs;
+      try {
+        const dynid::dds::Reply r =
+            client_.call("runs", {{"vehicle", v}, {"format", "json"}}, timeout_);
+        if (r.status == dynid::dds::ReplyStatus::kOk) runs = json::parse(r.payload, nullptr, false);
+      } catch (const dynid::cli::NoServer&) {
+      }
       out.push_back({{"vehicle", v}, {"runs", runs.is_discarded() ? json() : runs}});
     }
     return out.dump();
@@ -139,7 +147,7 @@ void read_estimates(const dynid::dds::Participant& participant, FleetState& stat
     for (auto& sample : reader.wait_take(200ms)) {
       try {
         state.add(dynid::dds::from_wire(sample.data));
-      } catch (const dynid::InputError& e) {  // one malformed sample is dropped, said, not fatal
+      } catch (const std::exception& e) {  // one malformed sample is dropped, said, not fatal
         std::cerr << "dynid-dashboard: estimate dropped: " << e.what() << "\n";
       }
     }
@@ -165,6 +173,48 @@ void poll_fleet(Servers& servers, FleetState& state, const Options& o,
          waited += 100ms)
       std::this_thread::sleep_for(100ms);
   }
+}
+
+// Stopping on SIGINT and SIGTERM, whichever thread the signal lands on (a library may have
+// started threads before main that do not block it: OpenBLAS's pool, the sanitizers'): the
+// handler first calls the request client's own (request_client.hpp: a wait for a server's reply
+// ends within a second instead of at its timeout), then writes the signal to a pipe that one
+// thread of ours reads (wait_stop). Writing to a pipe is async-signal-safe; nothing else is done
+// in the handler.
+int g_stop_pipe[2] = {-1, -1};
+struct sigaction g_client_action = {};
+
+void request_stop(int signal) {
+  const char byte = static_cast<char>(signal);
+  [[maybe_unused]] const ssize_t written = write(g_stop_pipe[1], &byte, 1);
+}
+
+extern "C" void dashboard_stop_signal(int signal) {
+  const int saved = errno;
+  if (g_client_action.sa_handler != SIG_DFL && g_client_action.sa_handler != SIG_IGN)
+    g_client_action.sa_handler(signal);
+  request_stop(signal);
+  errno = saved;
+}
+
+void install_stop_handler() {
+  dynid::cli::stop_on_signals();
+  sigaction(SIGTERM, nullptr, &g_client_action);
+  if (pipe2(g_stop_pipe, O_CLOEXEC) != 0)
+    throw std::runtime_error("pipe2: " + std::string(std::strerror(errno)));
+  struct sigaction action = {};
+  action.sa_handler = dashboard_stop_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+// The signal that asked to stop, 0 for a stop of our own.
+int wait_stop() {
+  char byte = 0;
+  while (read(g_stop_pipe[0], &byte, 1) < 0 && errno == EINTR) {
+  }
+  return byte;
 }
 
 std::pair<std::string, int> host_port(const std::string& listen) {
@@ -214,35 +264,33 @@ int main(int argc, char** argv) {
     std::cerr << "dynid-dashboard: " << e.what() << "\n";
     return 2;
   }
-  // SIGINT and SIGTERM go to one thread that stops everything (below), none to the others. That
-  // thread then raises the signal on itself, into the request client's handler, so that a wait
-  // for a server's reply ends within a second (request_client.hpp) instead of at its timeout.
-  dynid::cli::stop_on_signals();
-  sigset_t signals;
-  sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  install_stop_handler();
 
   std::unique_ptr<dynid::dds::Participant> participant;
+  std::unique_ptr<Servers> servers;
   try {
     dynid::dds::ParticipantOptions po{o.domain, dynid::dds::config_uri(o.config)};
     po.index_wait = 20s;
     participant = std::make_unique<dynid::dds::Participant>(po);
+    servers = std::make_unique<Servers>(
+        *participant, std::chrono::milliseconds(static_cast<long long>(o.timeout_s * 1000)));
   } catch (const dynid::dds::NoParticipantIndex& e) {
     std::cerr << "dynid-dashboard: " << e.what() << "\n";
     return 7;
+  } catch (const std::exception& e) {  // a configuration Cyclone refuses, a missing file
+    std::cerr << "dynid-dashboard: cannot join DDS domain " << o.domain
+              << " with the Cyclone configuration '" << o.config.substr(0, 200)
+              << "' (--cyclone-config or $DYNID_CYCLONE_CONFIG): " << e.what() << "\n";
+    return 2;
   }
   FleetState state(o.history);
-  Servers servers(*participant,
-                  std::chrono::milliseconds(static_cast<long long>(o.timeout_s * 1000)));
   httplib::Server http;
   // A connection holds one of the pool's threads while it is open, and each browser keeps its
   // event stream open: the library's default of 8 would let the eighth screen starve the others.
   http.new_task_queue = [] { return new httplib::ThreadPool(kConnections); };
   dynid::dashboard::install_routes(
       http, state, token, dynid::dashboard::page(),
-      [&servers](const std::string& v, const std::string& r) { return servers.run(v, r); });
+      [&servers](const std::string& v, const std::string& r) { return servers->run(v, r); });
   const int port = address.second == 0
                        ? http.bind_to_any_port(address.first)
                        : (http.bind_to_port(address.first, address.second) ? address.second : -1);
@@ -252,21 +300,20 @@ int main(int argc, char** argv) {
   }
   std::atomic<bool> stop{false};
   std::thread reader([&] { read_estimates(*participant, state, stop); });
-  std::thread poller([&] { poll_fleet(servers, state, o, stop); });
+  std::thread poller([&] { poll_fleet(*servers, state, o, stop); });
   std::thread stopper([&] {
-    int signal = 0;
-    sigwait(&signals, &signal);
-    std::cout << "dynid-dashboard: signal " << signal << ": stopping" << std::endl;
+    const int signal = wait_stop();
+    std::cout << "dynid-dashboard: "
+              << (signal > 0 ? "signal " + std::to_string(signal) : "the server ended")
+              << ": stopping" << std::endl;
     stop = true;
-    pthread_sigmask(SIG_UNBLOCK, &signals, nullptr);
-    raise(signal);
     state.close();
     http.stop();
   });
   std::cout << "dynid-dashboard: listening on http://" << address.first << ":" << port
             << "/ (open /login?token=... once)" << std::endl;
   http.listen_after_bind();
-  if (!stop) pthread_kill(stopper.native_handle(), SIGTERM);  // the server ended on its own
+  if (!stop) request_stop(0);  // the HTTP server ended on its own
   stopper.join();
   reader.join();
   poller.join();
